@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Sets everything up, builds, and runs the whole test suite (CTest).
+# Tests that need ../shared/scenes fail (not skip) when CI=true and it is missing.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+bash "$here/scripts/setup.sh"
+cd "$here/build"
+ctest --output-on-failure --timeout 1200 -j "$(nproc)" "$@"
