@@ -1,0 +1,223 @@
+#include "render/image_io.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+namespace rlpbrt {
+
+namespace {
+
+bool fail(std::string* error, const std::string& message) {
+    if (error) *error = message;
+    return false;
+}
+
+std::string lowerExtension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+// A temporary file next to `path` (same directory, so the final rename stays on one file
+// system) that is removed on destruction unless release() was called.
+class TempFile {
+public:
+    // Creates the file; on failure name() is empty and *error says why.
+    TempFile(const std::string& path, const std::string& ext, std::string* error) {
+        std::filesystem::path p(path);
+        std::filesystem::path dir = p.parent_path();
+        std::string tmpl = (dir / ("." + p.filename().string() + ".tmp-XXXXXX" + ext)).string();
+        std::vector<char> buf(tmpl.begin(), tmpl.end());
+        buf.push_back('\0');
+        int fd = mkstemps(buf.data(), int(ext.size()));
+        if (fd < 0) {
+            if (error) {
+                *error = "cannot create a temporary file next to \"" + path +
+                         "\": " + std::strerror(errno);
+            }
+            return;
+        }
+        ::close(fd);
+        name_ = buf.data();
+    }
+    ~TempFile() {
+        if (!name_.empty()) std::remove(name_.c_str());
+    }
+    TempFile(const TempFile&) = delete;
+    TempFile& operator=(const TempFile&) = delete;
+
+    const std::string& name() const { return name_; }
+    void release() { name_.clear(); }
+
+private:
+    std::string name_;
+};
+
+// Writes img (3 channels, finite) as a little-endian PFM (rows bottom to top).
+bool writePfm(const std::string& file, const Image& img, std::string* error) {
+    std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(file.c_str(), "wb"), &std::fclose);
+    if (!f) return fail(error, "cannot open \"" + file + "\": " + std::strerror(errno));
+    if (std::fprintf(f.get(), "PF\n%d %d\n-1.0\n", img.width, img.height) < 0)
+        return fail(error, "write error on \"" + file + "\"");
+    std::vector<unsigned char> row(size_t(img.width) * 3 * 4);
+    for (int y = img.height - 1; y >= 0; --y) {
+        const float* src = &img.pixels[size_t(y) * img.width * 3];
+        for (size_t i = 0; i < size_t(img.width) * 3; ++i) {
+            uint32_t bits;
+            std::memcpy(&bits, &src[i], 4);
+            for (int b = 0; b < 4; ++b) row[4 * i + b] = (unsigned char)(bits >> (8 * b));
+        }
+        if (std::fwrite(row.data(), 1, row.size(), f.get()) != row.size())
+            return fail(error, "write error on \"" + file + "\"");
+    }
+    if (std::fclose(f.release()) != 0) return fail(error, "write error on \"" + file + "\"");
+    return true;
+}
+
+// Writes through OIIO: `data` holds img.width * img.height * 3 values of type `type`.
+bool writeOiio(const std::string& file, const OIIO::ImageSpec& spec, const void* data,
+               std::string* error) {
+    auto out = OIIO::ImageOutput::create(file);
+    if (!out) return fail(error, "cannot write \"" + file + "\": " + OIIO::geterror());
+    if (!out->open(file, spec))
+        return fail(error, "cannot open \"" + file + "\": " + out->geterror());
+    if (!out->write_image(spec.format, data)) {
+        std::string msg = out->geterror();
+        out->close();
+        return fail(error, "cannot write \"" + file + "\": " + msg);
+    }
+    if (!out->close()) return fail(error, "cannot close \"" + file + "\": " + out->geterror());
+    return true;
+}
+
+}  // namespace
+
+float srgbToLinear(float v) {
+    if (v <= 0.04045f) return v * (1.f / 12.92f);
+    return std::pow((v + 0.055f) * (1.f / 1.055f), 2.4f);
+}
+
+float linearToSrgb(float v) {
+    if (v <= 0.0031308f) return 12.92f * v;
+    return 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+
+bool pbrtDefaultGamma(const std::string& path) {
+    std::string ext = lowerExtension(path);
+    return ext == ".png" || ext == ".tga";
+}
+
+bool readImage(const std::string& path, Image* out, std::string* error, ImageFileInfo* info) {
+    // Keep alpha unassociated: we want the stored colour values, not colour * alpha.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    if (!in) return fail(error, "cannot read image \"" + path + "\": " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    const int w = spec.width, h = spec.height, nc = spec.nchannels;
+    if (w <= 0 || h <= 0 || nc <= 0 || spec.depth > 1)
+        return fail(error, "image \"" + path + "\" has an unsupported size or layout");
+    std::vector<float> buf(size_t(w) * h * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, buf.data())) {
+        return fail(error, "cannot read pixels of \"" + path + "\": " + in->geterror());
+    }
+    if (info) {
+        info->format = in->format_name();
+        info->fileChannels = nc;
+        info->eightBit = spec.format == OIIO::TypeDesc::UINT8;
+    }
+    in->close();
+
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.channels = 3;
+    img.pixels.resize(size_t(w) * h * 3);
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+        const float* src = &buf[i * nc];
+        float* dst = &img.pixels[i * 3];
+        if (nc < 3) {
+            dst[0] = dst[1] = dst[2] = src[0];  // grey (+ alpha)
+        } else {
+            dst[0] = src[0];
+            dst[1] = src[1];
+            dst[2] = src[2];
+        }
+    }
+    *out = std::move(img);
+    return true;
+}
+
+bool writeImage(const std::string& path, const Image& img,
+                const std::vector<std::pair<std::string, std::string>>& metadata,
+                std::string* error) {
+    const std::string ext = lowerExtension(path);
+    if (ext != ".exr" && ext != ".png" && ext != ".pfm" && ext != ".hdr") {
+        return fail(error, "cannot write \"" + path +
+                               "\": unknown image format (use .exr, .png, .pfm or .hdr)");
+    }
+    if (img.channels != 3 || img.width <= 0 || img.height <= 0 ||
+        img.pixels.size() != size_t(img.width) * img.height * 3) {
+        return fail(error, "cannot write \"" + path + "\": not a non-empty RGB image");
+    }
+
+    // Non-finite values are a caller bug; never let them reach the file.
+    std::vector<float> clean(img.pixels);
+    for (float& v : clean) {
+        assert(std::isfinite(v) && "writeImage: non-finite pixel value");
+        if (!std::isfinite(v)) v = 0.f;
+    }
+
+    TempFile tmp(path, ext, error);
+    if (tmp.name().empty()) return false;
+
+    bool ok;
+    if (ext == ".pfm") {
+        Image copy;
+        copy.width = img.width;
+        copy.height = img.height;
+        copy.channels = 3;
+        copy.pixels = std::move(clean);
+        ok = writePfm(tmp.name(), copy, error);
+    } else if (ext == ".png") {
+        std::vector<uint8_t> bytes(clean.size());
+        for (size_t i = 0; i < clean.size(); ++i) {
+            float e = linearToSrgb(std::clamp(clean[i], 0.f, 1.f));
+            bytes[i] = uint8_t(std::clamp(std::floor(255.f * e + 0.5f), 0.f, 255.f));
+        }
+        OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
+        spec.attribute("oiio:ColorSpace", "sRGB");
+        for (const auto& kv : metadata) spec.attribute(kv.first, kv.second);
+        ok = writeOiio(tmp.name(), spec, bytes.data(), error);
+    } else {
+        OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
+        if (ext == ".exr") {
+            spec.attribute("compression", "zip");
+            for (const auto& kv : metadata) spec.attribute(kv.first, kv.second);
+        }
+        ok = writeOiio(tmp.name(), spec, clean.data(), error);
+    }
+    if (!ok) return false;
+
+    if (std::rename(tmp.name().c_str(), path.c_str()) != 0) {
+        return fail(error, "cannot rename \"" + tmp.name() + "\" to \"" + path +
+                               "\": " + std::strerror(errno));
+    }
+    tmp.release();
+    return true;
+}
+
+}  // namespace rlpbrt
