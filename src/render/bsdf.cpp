@@ -1,0 +1,255 @@
+#include "render/bsdf.h"
+
+namespace rlpbrt {
+
+void BSDF::init(const Vec3& ng, const Vec3& ns, const Vec3& tangent, float eta) {
+    ng_ = glm::normalize(ng);
+    Vec3 n = glm::normalize(ns);
+    Vec3 s = tangent - n * glm::dot(n, tangent);
+    float len2 = glm::dot(s, s);
+    if (len2 > 1e-12f && std::isfinite(len2)) {
+        s /= std::sqrt(len2);
+        frame_ = Frame(s, glm::cross(n, s), n);
+    } else {
+        frame_ = Frame::fromZ(n);
+    }
+    eta_ = eta;
+    n_ = 0;
+}
+
+bool BSDF::add(const BxDF& bxdf) {
+    if (n_ >= MaxBxDFs) return false;
+    bxdfs_[n_++] = bxdf;
+    return true;
+}
+
+int BSDF::numComponents(BxDFFlags flags) const {
+    int count = 0;
+    for (int i = 0; i < n_; ++i)
+        if (bxdfs_[i].matchesFlags(flags)) ++count;
+    return count;
+}
+
+bool BSDF::isDelta() const {
+    if (n_ == 0) return false;
+    for (int i = 0; i < n_; ++i)
+        if (!hasAny(bxdfs_[i].flags(), BxDFFlags::Specular)) return false;
+    return true;
+}
+
+BxDFFlags BSDF::flags() const {
+    BxDFFlags all = BxDFFlags::None;
+    for (int i = 0; i < n_; ++i) all = all | bxdfs_[i].flags();
+    return all;
+}
+
+Spectrum BSDF::f(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags) const {
+    Vec3 wi = worldToLocal(wiWorld), wo = worldToLocal(woWorld);
+    if (wo.z == 0.f) return Spectrum(0.f);
+    // The geometric normal decides between reflection and transmission, avoiding light leaks
+    // when shading normals disagree with the true surface.
+    bool reflect = glm::dot(wiWorld, ng_) * glm::dot(woWorld, ng_) > 0.f;
+    Spectrum sum(0.f);
+    for (int i = 0; i < n_; ++i) {
+        const BxDF& b = bxdfs_[i];
+        if (!b.matchesFlags(flags)) continue;
+        BxDFFlags bf = b.flags();
+        if ((reflect && hasAny(bf, BxDFFlags::Reflection)) ||
+            (!reflect && hasAny(bf, BxDFFlags::Transmission)))
+            sum += b.f(wo, wi);
+    }
+    return sum;
+}
+
+BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags) const {
+    int matching = numComponents(flags);
+    if (matching == 0) return BSDFSample();
+    // Choose the matching lobe; its share of uc is rescaled to [0,1) for the lobe itself.
+    int comp = std::min(static_cast<int>(uc * matching), matching - 1);
+    const BxDF* chosen = nullptr;
+    int chosenIndex = -1;
+    for (int i = 0, count = comp; i < n_; ++i) {
+        if (bxdfs_[i].matchesFlags(flags) && count-- == 0) {
+            chosen = &bxdfs_[i];
+            chosenIndex = i;
+            break;
+        }
+    }
+    float ucRemapped = std::min(uc * matching - comp, OneMinusEpsilon);
+
+    Vec3 wo = worldToLocal(woWorld);
+    if (wo.z == 0.f) return BSDFSample();
+    BxDFSample ls = chosen->sampleF(wo, ucRemapped, u);
+    if (!(ls.pdf > 0.f)) return BSDFSample();
+
+    BSDFSample s;
+    s.wi = localToWorld(ls.wi);
+    s.flags = ls.flags;
+    s.pdf = ls.pdf;
+    s.f = ls.f;
+    bool specular = hasAny(chosen->flags(), BxDFFlags::Specular);
+    // Non-specular: the sample could have come from any matching lobe (one-sample MIS).
+    if (!specular && matching > 1) {
+        for (int i = 0; i < n_; ++i)
+            if (i != chosenIndex && bxdfs_[i].matchesFlags(flags))
+                s.pdf += bxdfs_[i].pdf(wo, ls.wi);
+    }
+    if (matching > 1) s.pdf /= matching;
+    if (!specular) {
+        bool reflect = glm::dot(s.wi, ng_) * glm::dot(woWorld, ng_) > 0.f;
+        Spectrum sum(0.f);
+        for (int i = 0; i < n_; ++i) {
+            const BxDF& b = bxdfs_[i];
+            if (!b.matchesFlags(flags)) continue;
+            BxDFFlags bf = b.flags();
+            if ((reflect && hasAny(bf, BxDFFlags::Reflection)) ||
+                (!reflect && hasAny(bf, BxDFFlags::Transmission)))
+                sum += b.f(wo, ls.wi);
+        }
+        s.f = sum;
+    }
+    return s;
+}
+
+float BSDF::pdf(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags) const {
+    if (n_ == 0) return 0.f;
+    Vec3 wo = worldToLocal(woWorld), wi = worldToLocal(wiWorld);
+    if (wo.z == 0.f) return 0.f;
+    float sum = 0.f;
+    int matching = 0;
+    for (int i = 0; i < n_; ++i) {
+        if (!bxdfs_[i].matchesFlags(flags)) continue;
+        ++matching;
+        sum += bxdfs_[i].pdf(wo, wi);
+    }
+    return matching > 0 ? sum / matching : 0.f;
+}
+
+// ---- Material builders -------------------------------------------------------------------
+
+namespace {
+Spectrum clampNonNegative(const Spectrum& s) { return glm::max(s, Spectrum(0.f)); }
+float toAlpha(float roughness, bool remap) {
+    return remap ? TrowbridgeReitzDistribution::roughnessToAlpha(roughness) : roughness;
+}
+MicrofacetDistribution trDistribution(float uRough, float vRough, bool remap) {
+    return MicrofacetDistribution(MicrofacetType::TrowbridgeReitz, toAlpha(uRough, remap),
+                                  toAlpha(vRough, remap));
+}
+}  // namespace
+
+void buildMatte(BSDF& bsdf, Spectrum kd, float sigmaDeg) {
+    bsdf.clear();
+    bsdf.setEta(1.f);
+    kd = clampNonNegative(kd);
+    float sigma = clamp(sigmaDeg, 0.f, 90.f);
+    if (isBlack(kd)) return;
+    if (sigma == 0.f)
+        bsdf.add(LambertianReflection(kd));
+    else
+        bsdf.add(OrenNayar(kd, sigma));
+}
+
+void buildPlastic(BSDF& bsdf, Spectrum kd, Spectrum ks, float roughness, bool remap) {
+    bsdf.clear();
+    bsdf.setEta(1.f);
+    kd = clampNonNegative(kd);
+    if (!isBlack(kd)) bsdf.add(LambertianReflection(kd));
+    ks = clampNonNegative(ks);
+    if (!isBlack(ks)) {
+        bsdf.add(MicrofacetReflection(ks, trDistribution(roughness, roughness, remap),
+                                      Fresnel::dielectric(1.5f, 1.f)));
+    }
+}
+
+void buildMetal(BSDF& bsdf, Spectrum eta, Spectrum k, float uRough, float vRough, bool remap) {
+    bsdf.clear();
+    bsdf.setEta(1.f);
+    bsdf.add(MicrofacetReflection(Spectrum(1.f), trDistribution(uRough, vRough, remap),
+                                  Fresnel::conductor(Spectrum(1.f), eta, k)));
+}
+
+void buildGlass(BSDF& bsdf, Spectrum kr, Spectrum kt, float eta, float uRough, float vRough,
+                bool remap, TransportMode mode) {
+    bsdf.clear();
+    bsdf.setEta(eta);
+    kr = clampNonNegative(kr);
+    kt = clampNonNegative(kt);
+    if (isBlack(kr) && isBlack(kt)) return;
+    bool isSpecular = uRough == 0.f && vRough == 0.f;
+    if (isSpecular) {
+        bsdf.add(FresnelSpecular(kr, kt, 1.f, eta, mode));
+        return;
+    }
+    MicrofacetDistribution distrib = trDistribution(uRough, vRough, remap);
+    if (!isBlack(kr))
+        bsdf.add(MicrofacetReflection(kr, distrib, Fresnel::dielectric(1.f, eta)));
+    if (!isBlack(kt)) bsdf.add(MicrofacetTransmission(kt, distrib, 1.f, eta, mode));
+}
+
+void buildMirror(BSDF& bsdf, Spectrum kr) {
+    bsdf.clear();
+    bsdf.setEta(1.f);
+    kr = clampNonNegative(kr);
+    if (isBlack(kr)) return;
+    bsdf.add(SpecularReflection(kr, Fresnel::noOp()));
+}
+
+void buildUber(BSDF& bsdf, Spectrum kd, Spectrum ks, Spectrum kr, Spectrum kt, float uRough,
+               float vRough, Spectrum opacity, float eta, bool remap, TransportMode mode) {
+    bsdf.clear();
+    Spectrum op = clampNonNegative(opacity);
+    Spectrum t = clampNonNegative(Spectrum(1.f) - op);
+    if (!isBlack(t)) {
+        // Partially transparent: pass-through lobe, and no refraction for Russian roulette.
+        bsdf.setEta(1.f);
+        bsdf.add(SpecularTransmission(t, 1.f, 1.f, mode));
+    } else {
+        bsdf.setEta(eta);
+    }
+    kd = op * clampNonNegative(kd);
+    if (!isBlack(kd)) bsdf.add(LambertianReflection(kd));
+    ks = op * clampNonNegative(ks);
+    if (!isBlack(ks)) {
+        bsdf.add(MicrofacetReflection(ks, trDistribution(uRough, vRough, remap),
+                                      Fresnel::dielectric(1.f, eta)));
+    }
+    kr = op * clampNonNegative(kr);
+    if (!isBlack(kr)) bsdf.add(SpecularReflection(kr, Fresnel::dielectric(1.f, eta)));
+    kt = op * clampNonNegative(kt);
+    if (!isBlack(kt)) bsdf.add(SpecularTransmission(kt, 1.f, eta, mode));
+}
+
+void buildSubstrate(BSDF& bsdf, Spectrum kd, Spectrum ks, float uRough, float vRough,
+                    bool remap) {
+    bsdf.clear();
+    bsdf.setEta(1.f);
+    kd = clampNonNegative(kd);
+    ks = clampNonNegative(ks);
+    if (isBlack(kd) && isBlack(ks)) return;
+    bsdf.add(FresnelBlend(kd, ks, trDistribution(uRough, vRough, remap)));
+}
+
+void buildTranslucent(BSDF& bsdf, Spectrum kd, Spectrum ks, Spectrum reflect,
+                      Spectrum transmit, float roughness, bool remap, TransportMode mode) {
+    constexpr float eta = 1.5f;
+    bsdf.clear();
+    bsdf.setEta(eta);
+    Spectrum r = clampNonNegative(reflect);
+    Spectrum t = clampNonNegative(transmit);
+    if (isBlack(r) && isBlack(t)) return;
+    kd = clampNonNegative(kd);
+    if (!isBlack(kd)) {
+        if (!isBlack(r)) bsdf.add(LambertianReflection(r * kd));
+        if (!isBlack(t)) bsdf.add(LambertianTransmission(t * kd));
+    }
+    ks = clampNonNegative(ks);
+    if (!isBlack(ks)) {
+        MicrofacetDistribution distrib = trDistribution(roughness, roughness, remap);
+        if (!isBlack(r))
+            bsdf.add(MicrofacetReflection(r * ks, distrib, Fresnel::dielectric(1.f, eta)));
+        if (!isBlack(t)) bsdf.add(MicrofacetTransmission(t * ks, distrib, 1.f, eta, mode));
+    }
+}
+
+}  // namespace rlpbrt

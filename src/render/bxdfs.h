@@ -1,0 +1,239 @@
+// Reflection models with pbrt-v3 semantics: Fresnel terms and the BxDF lobes. All directions
+// are unit vectors in the local shading frame (z = shading normal), both pointing away from the
+// surface; wo is the outgoing (towards the camera for radiance) and wi the sampled direction.
+// BxDFs are small value types; `BxDF` is a std::variant over them, so a BSDF can hold them by
+// value without heap allocation.
+#pragma once
+
+#include <cstdint>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include "render/math.h"
+#include "render/microfacet.h"
+
+namespace rlpbrt {
+
+// Lobe classification bits (pbrt-v3 BxDFType).
+enum class BxDFFlags : uint8_t {
+    None = 0,
+    Reflection = 1 << 0,
+    Transmission = 1 << 1,
+    Diffuse = 1 << 2,
+    Glossy = 1 << 3,
+    Specular = 1 << 4,
+    All = 0x1f,
+};
+inline constexpr BxDFFlags operator|(BxDFFlags a, BxDFFlags b) {
+    return BxDFFlags(uint8_t(a) | uint8_t(b));
+}
+inline constexpr BxDFFlags operator&(BxDFFlags a, BxDFFlags b) {
+    return BxDFFlags(uint8_t(a) & uint8_t(b));
+}
+inline constexpr BxDFFlags operator~(BxDFFlags a) { return BxDFFlags(~uint8_t(a) & 0x1f); }
+// True if any bit of b is set in a.
+inline constexpr bool hasAny(BxDFFlags a, BxDFFlags b) { return uint8_t(a & b) != 0; }
+// True if flags of a lobe (lobe) are all contained in the requested set (pbrt MatchesFlags).
+inline constexpr bool matchesFlags(BxDFFlags lobe, BxDFFlags requested) {
+    return (lobe & requested) == lobe;
+}
+
+// Which quantity is being transported; affects the eta^2 scaling of transmission (pbrt-v3).
+enum class TransportMode : uint8_t { Radiance, Importance };
+
+// Unpolarised Fresnel reflectance of a dielectric interface. cosThetaI is the cosine of the
+// incident direction with the normal on the etaI side; negative values mean the direction is
+// on the etaT side (the indices are swapped). Returns 1 on total internal reflection.
+float frDielectric(float cosThetaI, float etaI, float etaT);
+// Fresnel reflectance of a conductor with complex index etaT + i k, seen from a medium etaI.
+Spectrum frConductor(float cosThetaI, const Spectrum& etaI, const Spectrum& etaT,
+                     const Spectrum& k);
+
+// A Fresnel term stored by value: no-op (always 1), dielectric, or conductor.
+class Fresnel {
+  public:
+    enum class Kind : uint8_t { NoOp, Dielectric, Conductor };
+    Fresnel() = default;
+    // Always returns 1 (pbrt FresnelNoOp, used by the mirror material).
+    static Fresnel noOp() { return Fresnel(); }
+    // Dielectric with etaI on the side of the normal (+z) and etaT below it.
+    static Fresnel dielectric(float etaI, float etaT);
+    // Conductor; pbrt-v3's evaluate uses |cosThetaI|.
+    static Fresnel conductor(const Spectrum& etaI, const Spectrum& etaT, const Spectrum& k);
+
+    Kind kind() const { return kind_; }
+    // Reflectance for the cosine of the incident direction with the normal.
+    Spectrum evaluate(float cosThetaI) const;
+
+  private:
+    Kind kind_ = Kind::NoOp;
+    Spectrum etaI_{1.f}, etaT_{1.f}, k_{0.f};
+};
+
+// Result of sampling a lobe: value f (1/sr; for specular lobes f includes 1/|cos wi| and the
+// delta is implied), direction wi, pdf (solid angle, or the discrete probability for specular
+// lobes) and the sampled lobe's flags. pdf == 0 means no sample.
+struct BxDFSample {
+    Spectrum f{0.f};
+    Vec3 wi{0.f};
+    float pdf = 0.f;
+    BxDFFlags flags = BxDFFlags::None;
+    bool valid() const { return pdf > 0.f; }
+    bool isSpecular() const { return hasAny(flags, BxDFFlags::Specular); }
+    bool isReflection() const { return hasAny(flags, BxDFFlags::Reflection); }
+    bool isTransmission() const { return hasAny(flags, BxDFFlags::Transmission); }
+};
+
+// Every lobe type below offers (uc: extra uniform float in [0,1), u: uniform point in [0,1)^2):
+//   Spectrum f(wo, wi)                  BSDF value, 1/sr (0 for specular lobes)
+//   BxDFSample sampleF(wo, uc, u)        importance sample
+//   float pdf(wo, wi)                   solid-angle density of sampleF (0 for specular lobes)
+//   BxDFFlags flags()
+
+// Lambertian reflection: f = R / pi, cosine-weighted sampling.
+struct LambertianReflection {
+    Spectrum r;
+    explicit LambertianReflection(const Spectrum& r = Spectrum(0.f)) : r(r) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Diffuse; }
+};
+
+// Lambertian transmission: f = T / pi into the opposite hemisphere.
+struct LambertianTransmission {
+    Spectrum t;
+    explicit LambertianTransmission(const Spectrum& t) : t(t) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Transmission | BxDFFlags::Diffuse; }
+};
+
+// Oren-Nayar rough diffuse reflection (qualitative model), sigma = slope deviation in degrees.
+struct OrenNayar {
+    Spectrum r;
+    float a, b;
+    OrenNayar(const Spectrum& r, float sigmaDeg);
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Diffuse; }
+};
+
+// Perfect mirror reflection scaled by R and a Fresnel term.
+struct SpecularReflection {
+    Spectrum r;
+    Fresnel fresnel;
+    SpecularReflection(const Spectrum& r, const Fresnel& fresnel) : r(r), fresnel(fresnel) {}
+    Spectrum f(const Vec3&, const Vec3&) const { return Spectrum(0.f); }
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3&, const Vec3&) const { return 0.f; }
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Specular; }
+};
+
+// Perfect refraction between etaA (above, +z) and etaB (below) scaled by T (1 - Fresnel).
+// For TransportMode::Radiance the value is scaled by (etaI / etaT)^2.
+struct SpecularTransmission {
+    Spectrum t;
+    float etaA, etaB;
+    TransportMode mode;
+    SpecularTransmission(const Spectrum& t, float etaA, float etaB, TransportMode mode)
+        : t(t), etaA(etaA), etaB(etaB), mode(mode) {}
+    Spectrum f(const Vec3&, const Vec3&) const { return Spectrum(0.f); }
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3&, const Vec3&) const { return 0.f; }
+    BxDFFlags flags() const { return BxDFFlags::Transmission | BxDFFlags::Specular; }
+};
+
+// Smooth dielectric: chooses reflection with probability F and refraction with 1 - F (using
+// uc), so sampleF's pdf is F or 1 - F.
+struct FresnelSpecular {
+    Spectrum r, t;
+    float etaA, etaB;
+    TransportMode mode;
+    FresnelSpecular(const Spectrum& r, const Spectrum& t, float etaA, float etaB,
+                    TransportMode mode)
+        : r(r), t(t), etaA(etaA), etaB(etaB), mode(mode) {}
+    Spectrum f(const Vec3&, const Vec3&) const { return Spectrum(0.f); }
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3&, const Vec3&) const { return 0.f; }
+    BxDFFlags flags() const {
+        return BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Specular;
+    }
+};
+
+// Torrance-Sparrow microfacet reflection: R D G F / (4 |cos o| |cos i|).
+struct MicrofacetReflection {
+    Spectrum r;
+    MicrofacetDistribution distribution;
+    Fresnel fresnel;
+    MicrofacetReflection(const Spectrum& r, const MicrofacetDistribution& d, const Fresnel& fr)
+        : r(r), distribution(d), fresnel(fr) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
+};
+
+// Walter et al. microfacet transmission between etaA (above) and etaB (below).
+struct MicrofacetTransmission {
+    Spectrum t;
+    MicrofacetDistribution distribution;
+    float etaA, etaB;
+    TransportMode mode;
+    MicrofacetTransmission(const Spectrum& t, const MicrofacetDistribution& d, float etaA,
+                           float etaB, TransportMode mode)
+        : t(t), distribution(d), etaA(etaA), etaB(etaB), mode(mode) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Transmission | BxDFFlags::Glossy; }
+};
+
+// Ashikhmin-Shirley diffuse substrate under a glossy coating (pbrt FresnelBlend).
+struct FresnelBlend {
+    Spectrum rd, rs;
+    MicrofacetDistribution distribution;
+    FresnelBlend(const Spectrum& rd, const Spectrum& rs, const MicrofacetDistribution& d)
+        : rd(rd), rs(rs), distribution(d) {}
+    // Schlick's approximation with normal-incidence reflectance rs.
+    Spectrum schlickFresnel(float cosTheta) const;
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
+};
+
+// Any one lobe, stored by value.
+class BxDF {
+  public:
+    using Variant =
+        std::variant<LambertianReflection, LambertianTransmission, OrenNayar,
+                     SpecularReflection, SpecularTransmission, FresnelSpecular,
+                     MicrofacetReflection, MicrofacetTransmission, FresnelBlend>;
+
+    BxDF() = default;
+    template <typename T, typename = std::enable_if_t<!std::is_same_v<std::decay_t<T>, BxDF>>>
+    BxDF(T&& lobe) : v_(std::forward<T>(lobe)) {}
+
+    // BSDF value in 1/sr (0 for specular lobes).
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    // Importance sample of wi; see BxDFSample.
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    // Solid-angle density of sampleF at wi (0 for specular lobes).
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const;
+    bool matchesFlags(BxDFFlags requested) const {
+        return rlpbrt::matchesFlags(flags(), requested);
+    }
+    // The concrete lobe if it has type T, else nullptr.
+    template <typename T>
+    const T* get() const { return std::get_if<T>(&v_); }
+
+  private:
+    Variant v_;
+};
+
+}  // namespace rlpbrt

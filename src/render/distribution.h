@@ -1,0 +1,75 @@
+// Piecewise-constant 1D and 2D distributions over [0,1] and [0,1]^2, for environment-map
+// importance sampling and light selection (pbrt-v3's Distribution1D / Distribution2D semantics).
+#pragma once
+
+#include <vector>
+
+#include "render/math.h"
+
+namespace rlpbrt {
+
+// Piecewise-constant density over [0,1] proportional to n non-negative function values.
+// Negative or non-finite values are treated as 0. If every value is 0 the distribution falls
+// back to uniform sampling (integral() still reports 0).
+class Distribution1D {
+  public:
+    Distribution1D() = default;
+    // Builds from n >= 1 values; f[i] covers [i/n, (i+1)/n).
+    Distribution1D(const float* f, int n);
+    explicit Distribution1D(const std::vector<float>& f)
+        : Distribution1D(f.data(), static_cast<int>(f.size())) {}
+
+    // Number of pieces.
+    int count() const { return static_cast<int>(func_.size()); }
+    // Integral of the (sanitised) function over [0,1]: (1/n) * sum f[i].
+    float integral() const { return funcInt_; }
+    // Function value of piece i (after sanitising).
+    float func(int i) const { return func_[i]; }
+
+    // Samples x in [0,1) from uniform u in [0,1); *pdf receives the density w.r.t. x on [0,1]
+    // and *offset the piece index.
+    float sampleContinuous(float u, float* pdf = nullptr, int* offset = nullptr) const;
+    // Samples a piece index with probability f[i] / sum f; *pmf receives that probability and
+    // *uRemapped the position of u inside the chosen piece's CDF interval, in [0,1).
+    int sampleDiscrete(float u, float* pmf = nullptr, float* uRemapped = nullptr) const;
+    // Probability of choosing piece i in sampleDiscrete.
+    float discretePmf(int i) const;
+    // Density w.r.t. x on [0,1] of sampleContinuous at x (0 outside [0,1]).
+    float pdf(float x) const;
+
+  private:
+    // Index of the piece whose CDF interval contains u.
+    int findInterval(float u) const;
+    // Density of piece i relative to the unit interval (uniform fallback when all zero).
+    float pieceDensity(int i) const { return uniform_ ? 1.f : func_[i] / funcInt_; }
+
+    std::vector<float> func_;
+    std::vector<float> cdf_;  // n+1 entries, cdf_[0] = 0, cdf_[n] = 1
+    float funcInt_ = 0.f;
+    bool uniform_ = true;
+};
+
+// Piecewise-constant density over [0,1]^2 from an nu x nv grid of non-negative values stored
+// row by row (value (iu, iv) at f[iv * nu + iu]); u is the fast (column) coordinate.
+class Distribution2D {
+  public:
+    Distribution2D() = default;
+    Distribution2D(const float* f, int nu, int nv);
+
+    int countU() const { return conditional_.empty() ? 0 : conditional_[0].count(); }
+    int countV() const { return static_cast<int>(conditional_.size()); }
+    // Integral of the function over [0,1]^2.
+    float integral() const { return marginal_.integral(); }
+
+    // Samples a point in [0,1)^2 from uniform u; *pdf receives the density w.r.t. area on
+    // [0,1]^2. v is chosen from the marginal with u.y, then u from the row's conditional with u.x.
+    Vec2 sampleContinuous(Vec2 u, float* pdf) const;
+    // Density w.r.t. area on [0,1]^2 at point p.
+    float pdf(Vec2 p) const;
+
+  private:
+    std::vector<Distribution1D> conditional_;
+    Distribution1D marginal_;
+};
+
+}  // namespace rlpbrt
