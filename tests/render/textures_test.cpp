@@ -286,7 +286,7 @@ TEST(Textures, Checkerboard2DClosedForm) {
     // s in [0.5, 1.5] (half even, half odd), t in [0.3, 0.7]: half of each.
     TextureContext ctx = atUV(1.f, 0.5f, 0.5f, 0.2f);
     EXPECT_NEAR(c->evaluate(ctx), 0.5f, 1e-6f);
-    // s in [0.75, 1.25]... centred at 0.875 with half-width 0.25: [0.625, 1.125] is 3/4 even.
+    // s in [0.625, 1.125] (centre 0.875, half-width 0.25) is 3/4 on the even check.
     EXPECT_NEAR(c->evaluate(atUV(0.875f, 0.5f, 0.25f, 0.1f)), 0.75f, 1e-6f);
     // Zero t-width (pbrt-v3 would give NaN): limit value.
     EXPECT_NEAR(c->evaluate(atUV(1.f, 0.5f, 0.5f, 0.f)), 0.5f, 1e-6f);
@@ -322,8 +322,8 @@ TEST(Textures, DotsMatchNoiseAndPbrtV3ParameterOrder) {
             float sCenter = sc + 0.15f * perlinNoise(sc + 1.5f, tc + 2.8f);
             float tCenter = tc + 0.15f * perlinNoise(sc + 4.5f, tc + 9.8f);
             EXPECT_EQ(dots->evaluate(atUV(sCenter, tCenter)), 3.f);
-            // 0.45 from the centre is outside the dot (radius 0.35) but in the same cell
-            // only if still within [c - 0.5, c + 0.5); use the t direction towards the cell.
+            // 0.4 from the dot centre, towards the cell centre: outside the dot (radius 0.35)
+            // and still inside the cell (the centre is within 0.15 of the cell centre).
             float tFar = tCenter + (tCenter > tc ? -0.4f : 0.4f);
             EXPECT_EQ(dots->evaluate(atUV(sCenter, tFar)), 7.f);
             ++found;
