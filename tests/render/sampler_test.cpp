@@ -446,7 +446,8 @@ struct ErrorStats {
 // Per-pixel estimates of the integral of exp(-x^2 - y^2) over [0,1)^2 with n samples from
 // the 2D pair at dimension 4 (after the film and one 1D dimension), over P pixels.
 ErrorStats integrationError(Sampler& s, int n, int P) {
-    const double exact = std::pow(0.5 * std::sqrt(M_PI) * std::erf(1.0), 2);
+    const double pi = 3.14159265358979323846;
+    const double exact = std::pow(0.5 * std::sqrt(pi) * std::erf(1.0), 2);
     double sum = 0, sum2 = 0;
     for (int p = 0; p < P; ++p) {
         double est = 0;
