@@ -130,16 +130,17 @@ MipMap<T>::MipMap(int width, int height, std::vector<T> texels, ImageWrap wrap)
             }
         std::vector<ResampleWeight> tw = resampleWeights(height, h2);
         std::vector<T> out(size_t(w2) * h2, T(0.f));
-        for (int s = 0; s < w2; ++s)
-            for (int t = 0; t < h2; ++t) {
-                T sum(0.f);
-                for (int j = 0; j < 4; ++j) {
-                    int ot = wrapIndex(tw[t].firstTexel + j, height, wrap);
-                    if (ot >= 0) sum += tw[t].weight[j] * wide[size_t(ot) * w2 + s];
-                }
-                // Lanczos lobes can ring below zero; texels must stay non-negative.
-                out[size_t(t) * w2 + s] = clampZero(sum);
+        for (int t = 0; t < h2; ++t) {
+            T* row = &out[size_t(t) * w2];
+            for (int j = 0; j < 4; ++j) {
+                int ot = wrapIndex(tw[t].firstTexel + j, height, wrap);
+                if (ot < 0) continue;
+                const T* src = &wide[size_t(ot) * w2];
+                for (int s = 0; s < w2; ++s) row[s] += tw[t].weight[j] * src[s];
             }
+            // Lanczos lobes can ring below zero; texels must stay non-negative.
+            for (int s = 0; s < w2; ++s) row[s] = clampZero(row[s]);
+        }
         texels = std::move(out);
         width = w2;
         height = h2;
