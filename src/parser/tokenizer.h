@@ -1,0 +1,50 @@
+// Tokenizer for pbrt-v3 scene files: quoted strings, numbers, brackets, bare words, '#'
+// comments. Every token carries its FileLoc. Whole files are read into memory once.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "parser/diagnostics.h"
+
+namespace rlpbrt {
+
+struct Token {
+    std::string_view text;  // raw text; strings keep their quotes
+    FileLoc loc;
+    bool isString() const { return !text.empty() && text[0] == '"'; }
+    bool is(char c) const { return text.size() == 1 && text[0] == c; }
+    // Looks like a number (starts with a digit, '.', '-' or '+').
+    bool isNumberLike() const;
+};
+
+class Tokenizer {
+public:
+    // Reads a whole file. Returns null and reports at `includedFrom` if it cannot be read.
+    static std::unique_ptr<Tokenizer> fromFile(const std::string& path, Diagnostics& diag,
+                                               const FileLoc& includedFrom);
+    static std::unique_ptr<Tokenizer> fromString(std::string text, const std::string& name,
+                                                 Diagnostics& diag);
+
+    // The next token; false at end of input. Lexical errors (unterminated string, stray
+    // control character) are reported and the offending characters skipped.
+    bool next(Token* tok);
+    const std::string* fileName() const { return file_; }
+    const std::string& path() const { return *file_; }
+
+private:
+    Tokenizer(std::string contents, const std::string* file, Diagnostics& diag);
+    FileLoc here(std::size_t pos) const { return FileLoc{file_, line_, int(pos - lineStart_) + 1}; }
+
+    std::string contents_;
+    const std::string* file_;
+    Diagnostics& diag_;
+    std::size_t pos_ = 0, lineStart_ = 0;
+    int line_ = 1;
+};
+
+// Removes the quotes and resolves escapes (\" \\ \n \t \b \f \r) of a string token.
+std::string unquote(std::string_view quoted);
+
+}  // namespace rlpbrt

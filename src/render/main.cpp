@@ -1,0 +1,168 @@
+// rlpbrt: renders pbrt-v3 scenes with a path tracer whose directions can be learned.
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <thread>
+#include <unistd.h>
+
+#include "parser/diagnostics.h"
+#include "render/image_io.h"
+#include "render/render.h"
+#include "render/scene.h"
+#include "render/scene_builder.h"
+
+using namespace rlpbrt;
+
+namespace {
+
+double seconds() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+std::atomic<bool> gCancel{false};
+extern "C" void onSignal(int) { gCancel.store(true); }
+
+void printSummary(const SceneDesc& desc, const Scene& scene, const Diagnostics& diag,
+                  double parseSec, double buildSec) {
+    const SceneStats& s = scene.stats;
+    std::printf("shapes: %zu (%zu triangles in meshes, %zu quadrics)\n", s.shapes, s.triangles,
+                s.quadrics);
+    std::printf("instances: %zu of %zu objects (%zu instanced triangles)\n", s.instances,
+                desc.objects.size(), s.instancedTriangles);
+    std::printf("lights: %zu (%zu area lights, %zu other)\n", s.lights, s.areaLights,
+                s.lights - s.areaLights);
+    std::printf("materials: %zu\n", s.materials);
+    std::printf("textures: %zu\n", s.textures);
+    std::printf("camera: %s, film %dx%d, sampler %s %d spp, integrator %s maxdepth %d\n",
+                desc.camera.present ? desc.camera.type.c_str() : "perspective",
+                scene.filmParams.xResolution, scene.filmParams.yResolution,
+                scene.samplerName.c_str(), scene.sampler->samplesPerPixel(),
+                scene.integrator.name.c_str(), scene.integrator.maxDepth);
+    std::printf("parse: %.3f s, build: %.3f s\n", parseSec, buildSec);
+    const auto& ignored = diag.ignoredFeatures();
+    std::printf("ignored features: %zu\n", ignored.size());
+    for (const auto& [what, count] : ignored) std::printf("  %s (x%d)\n", what.c_str(), count);
+}
+
+std::string defaultOutput(const Scene& scene) {
+    return scene.filmParams.filename.empty() ? std::string("pbrt.exr") : scene.filmParams.filename;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
+    std::string scenePath, outFile, statsFile, guide = "none";
+    bool parseOnly = false, quiet = false;
+    int spp = 0, nThreads = 0;
+    double timeBudget = 0.0;
+    uint64_t seed = 0;
+    app.add_option("scene", scenePath, "pbrt-v3 scene file")->required();
+    app.add_flag("--parse-only", parseOnly, "parse and build the scene, print a summary, exit");
+    app.add_option("--outfile,-o", outFile, "output image (.exr, .png, .pfm, .hdr); default: the "
+                                            "Film's filename");
+    app.add_option("--spp", spp, "samples per pixel (overrides the Sampler's pixelsamples)")
+        ->check(CLI::Range(1, 1 << 24));
+    app.add_option("--time", timeBudget, "render whole passes until SECONDS are spent")
+        ->check(CLI::Range(0.0, 1e9));
+    app.add_option("--nthreads", nThreads, "threads (default: all cores)")
+        ->check(CLI::Range(0, 4096));
+    app.add_option("--seed", seed, "random seed");
+    app.add_flag("--quiet,-q", quiet, "no progress or summary output");
+    app.add_option("--guide", guide, "guiding backend")->check(CLI::IsMember({"none"}));
+    app.add_option("--stats", statsFile, "write run statistics as JSON");
+    CLI11_PARSE(app, argc, argv);
+
+    Diagnostics diag;
+    double t0 = seconds();
+    SceneDesc desc;
+    bool ok = loadSceneDesc(scenePath, diag, &desc);
+    double parseSec = seconds() - t0;
+    if (!ok) {
+        std::fprintf(stderr, "rlpbrt: %d error(s); nothing rendered\n", diag.errorCount());
+        return 1;
+    }
+    BuildOptions bo;
+    bo.sppOverride = spp;
+    bo.seed = seed;
+    bo.nThreads = nThreads;
+    double t1 = seconds();
+    std::unique_ptr<Scene> scene;
+    try {
+        scene = buildScene(desc, bo, diag);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "%s: error: %s\n", scenePath.c_str(), e.what());
+        return 1;
+    }
+    double buildSec = seconds() - t1;
+    if (!scene || diag.errorCount() > 0) {
+        std::fprintf(stderr, "rlpbrt: %d error(s); nothing rendered\n", diag.errorCount());
+        return 1;
+    }
+    if (parseOnly) {
+        printSummary(desc, *scene, diag, parseSec, buildSec);
+        return 0;
+    }
+
+    if (outFile.empty()) outFile = defaultOutput(*scene);
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    RenderOptions ro;
+    ro.nThreads = nThreads;
+    ro.timeBudget = timeBudget;
+    ro.progress = !quiet && isatty(STDERR_FILENO);
+    ro.cancel = &gCancel;
+    RenderResult r = render(*scene, ro);
+
+    std::vector<std::pair<std::string, std::string>> meta = {
+        {"rlpbrt:version", RLPBRT_VERSION},
+        {"rlpbrt:spp", std::to_string(r.spp)},
+        {"rlpbrt:seconds", std::to_string(r.seconds)},
+        {"rlpbrt:seed", std::to_string(seed)},
+        {"rlpbrt:guide", guide},
+        {"rlpbrt:scene", scenePath},
+    };
+    std::string err;
+    if (!writeImage(outFile, r.image, meta, &err)) {
+        std::fprintf(stderr, "%s: error: %s\n", outFile.c_str(), err.c_str());
+        return 1;
+    }
+    if (r.stats.nonFinite > 0)
+        std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n",
+                     (unsigned long long)r.stats.nonFinite);
+    if (!statsFile.empty()) {
+        const PathStats& s = r.stats;
+        nlohmann::json j;
+        j["seconds"] = r.seconds;
+        j["parse_seconds"] = parseSec;
+        j["build_seconds"] = buildSec;
+        j["spp"] = r.spp;
+        j["rays"] = s.rays;
+        j["paths"] = s.paths;
+        j["zero_contribution_fraction"] = s.paths ? double(s.zeroRadiancePaths) / s.paths : 0.0;
+        j["mean_path_length"] = s.paths ? double(s.vertices) / s.paths : 0.0;
+        j["guide"] = guide;
+        j["guide_bytes"] = 0;
+        j["nonfinite_samples"] = s.nonFinite;
+        j["cancelled"] = r.cancelled;
+        std::ofstream f(statsFile);
+        f << j.dump(2) << "\n";
+        if (!f) {
+            std::fprintf(stderr, "%s: error: cannot write statistics\n", statsFile.c_str());
+            return 1;
+        }
+    }
+    if (!quiet)
+        std::fprintf(stderr, "rendered %s: %dx%d, %d spp in %.2f s (parse %.2f s, build %.2f s), "
+                             "%.2f Mrays/s -> %s\n",
+                     scenePath.c_str(), r.image.width, r.image.height, r.spp, r.seconds, parseSec,
+                     buildSec, r.stats.rays / std::max(r.seconds, 1e-9) * 1e-6, outFile.c_str());
+    return r.cancelled ? 130 : 0;
+}

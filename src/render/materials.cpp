@@ -1,0 +1,332 @@
+#include "render/materials.h"
+
+#include <algorithm>
+
+namespace rlpbrt {
+
+Material::~Material() = default;
+
+TextureContext textureContext(const SurfaceInteraction& si) {
+    TextureContext tc;
+    tc.p = si.p;
+    tc.dpdx = tc.dpdy = Vec3(0.f);
+    tc.n = si.ns;
+    tc.uv = si.uv;
+    return tc;
+}
+
+namespace {
+
+using FTex = std::shared_ptr<FloatTexture>;
+using STex = std::shared_ptr<SpectrumTexture>;
+
+Spectrum clampZero(const Spectrum& s) { return glm::max(s, Spectrum(0.f)); }
+
+// Shared by every material type: the bump map and the shading frame.
+class SurfaceMaterial : public Material {
+public:
+    explicit SurfaceMaterial(FTex bump) : bump_(std::move(bump)) {}
+
+protected:
+    // Initializes the BSDF's frame at si (bump-mapped when a bump map is present).
+    void initFrame(const SurfaceInteraction& si, const TextureContext& tc, BSDF* bsdf,
+                   float eta = 1.f) const {
+        Vec3 ns = si.ns, dpdu = si.dpdu;
+        if (bump_) {
+            BumpInput in;
+            in.p = si.p;
+            in.n = si.ng;
+            in.ns = si.ns;
+            in.dpdu = si.dpdu;
+            in.dpdv = si.dpdv;
+            in.dndu = si.dndu;
+            in.dndv = si.dndv;
+            in.uv = si.uv;
+            Vec3 dpdv;
+            bump(*bump_, in, &dpdu, &dpdv, &ns);
+            if (!isFinite(ns) || glm::dot(ns, ns) == 0.f) {
+                ns = si.ns;
+                dpdu = si.dpdu;
+            }
+        }
+        Vec3 tangent = glm::length(si.shadingTangent) > 0.f ? si.shadingTangent : dpdu;
+        bsdf->init(si.ng, ns, tangent, eta);
+        (void)tc;
+    }
+
+    FTex bump_;
+};
+
+class MatteMaterial : public SurfaceMaterial {
+public:
+    MatteMaterial(STex kd, FTex sigma, FTex bump)
+        : SurfaceMaterial(std::move(bump)), kd_(std::move(kd)), sigma_(std::move(sigma)) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf);
+        buildMatte(*bsdf, clampZero(kd_->evaluate(tc)), clamp(sigma_->evaluate(tc), 0.f, 90.f));
+    }
+
+private:
+    STex kd_;
+    FTex sigma_;
+};
+
+class PlasticMaterial : public SurfaceMaterial {
+public:
+    PlasticMaterial(STex kd, STex ks, FTex rough, bool remap, FTex bump)
+        : SurfaceMaterial(std::move(bump)), kd_(std::move(kd)), ks_(std::move(ks)),
+          rough_(std::move(rough)), remap_(remap) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf);
+        buildPlastic(*bsdf, clampZero(kd_->evaluate(tc)), clampZero(ks_->evaluate(tc)),
+                     rough_->evaluate(tc), remap_);
+    }
+
+private:
+    STex kd_, ks_;
+    FTex rough_;
+    bool remap_;
+};
+
+class MetalMaterial : public SurfaceMaterial {
+public:
+    MetalMaterial(STex eta, STex k, FTex u, FTex v, bool remap, FTex bump)
+        : SurfaceMaterial(std::move(bump)), eta_(std::move(eta)), k_(std::move(k)),
+          u_(std::move(u)), v_(std::move(v)), remap_(remap) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf);
+        buildMetal(*bsdf, eta_->evaluate(tc), k_->evaluate(tc), u_->evaluate(tc),
+                   v_->evaluate(tc), remap_);
+    }
+
+private:
+    STex eta_, k_;
+    FTex u_, v_;
+    bool remap_;
+};
+
+class GlassMaterial : public SurfaceMaterial {
+public:
+    GlassMaterial(STex kr, STex kt, FTex eta, FTex u, FTex v, bool remap, FTex bump)
+        : SurfaceMaterial(std::move(bump)), kr_(std::move(kr)), kt_(std::move(kt)),
+          eta_(std::move(eta)), u_(std::move(u)), v_(std::move(v)), remap_(remap) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        float eta = eta_->evaluate(tc);
+        initFrame(si, tc, bsdf, eta);
+        buildGlass(*bsdf, clampZero(kr_->evaluate(tc)), clampZero(kt_->evaluate(tc)), eta,
+                   u_->evaluate(tc), v_->evaluate(tc), remap_);
+    }
+
+private:
+    STex kr_, kt_;
+    FTex eta_, u_, v_;
+    bool remap_;
+};
+
+class MirrorMaterial : public SurfaceMaterial {
+public:
+    MirrorMaterial(STex kr, FTex bump) : SurfaceMaterial(std::move(bump)), kr_(std::move(kr)) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf);
+        buildMirror(*bsdf, clampZero(kr_->evaluate(tc)));
+    }
+
+private:
+    STex kr_;
+};
+
+class UberMaterial : public SurfaceMaterial {
+public:
+    UberMaterial(STex kd, STex ks, STex kr, STex kt, FTex u, FTex v, STex opacity, FTex eta,
+                 bool remap, FTex bump)
+        : SurfaceMaterial(std::move(bump)), kd_(std::move(kd)), ks_(std::move(ks)),
+          kr_(std::move(kr)), kt_(std::move(kt)), u_(std::move(u)), v_(std::move(v)),
+          opacity_(std::move(opacity)), eta_(std::move(eta)), remap_(remap) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        float eta = eta_->evaluate(tc);
+        Spectrum op = glm::clamp(opacity_->evaluate(tc), Spectrum(0.f), Spectrum(1.f));
+        initFrame(si, tc, bsdf, isBlack(Spectrum(1.f) - op) ? eta : 1.f);
+        buildUber(*bsdf, clampZero(kd_->evaluate(tc)), clampZero(ks_->evaluate(tc)),
+                  clampZero(kr_->evaluate(tc)), clampZero(kt_->evaluate(tc)), u_->evaluate(tc),
+                  v_->evaluate(tc), op, eta, remap_);
+    }
+
+private:
+    STex kd_, ks_, kr_, kt_;
+    FTex u_, v_;
+    STex opacity_;
+    FTex eta_;
+    bool remap_;
+};
+
+class SubstrateMaterial : public SurfaceMaterial {
+public:
+    SubstrateMaterial(STex kd, STex ks, FTex u, FTex v, bool remap, FTex bump)
+        : SurfaceMaterial(std::move(bump)), kd_(std::move(kd)), ks_(std::move(ks)),
+          u_(std::move(u)), v_(std::move(v)), remap_(remap) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf);
+        buildSubstrate(*bsdf, clampZero(kd_->evaluate(tc)), clampZero(ks_->evaluate(tc)),
+                       u_->evaluate(tc), v_->evaluate(tc), remap_);
+    }
+
+private:
+    STex kd_, ks_;
+    FTex u_, v_;
+    bool remap_;
+};
+
+class TranslucentMaterial : public SurfaceMaterial {
+public:
+    TranslucentMaterial(STex kd, STex ks, STex reflect, STex transmit, FTex rough, bool remap,
+                        FTex bump)
+        : SurfaceMaterial(std::move(bump)), kd_(std::move(kd)), ks_(std::move(ks)),
+          reflect_(std::move(reflect)), transmit_(std::move(transmit)),
+          rough_(std::move(rough)), remap_(remap) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf, 1.5f);
+        buildTranslucent(*bsdf, clampZero(kd_->evaluate(tc)), clampZero(ks_->evaluate(tc)),
+                         glm::clamp(reflect_->evaluate(tc), Spectrum(0.f), Spectrum(1.f)),
+                         glm::clamp(transmit_->evaluate(tc), Spectrum(0.f), Spectrum(1.f)),
+                         rough_->evaluate(tc), remap_);
+    }
+
+private:
+    STex kd_, ks_, reflect_, transmit_;
+    FTex rough_;
+    bool remap_;
+};
+
+// pbrt-v3's mix weights m1 by `amount` and m2 by 1 - amount; here one of them is chosen per
+// shading point with those probabilities (the same expectation). A coloured amount uses its
+// average as the probability.
+class MixMaterial : public Material {
+public:
+    MixMaterial(const Material* m1, const Material* m2, STex amount)
+        : m1_(m1), m2_(m2), amount_(std::move(amount)) {}
+    void computeBSDF(const SurfaceInteraction& si, float u, BSDF* bsdf) const override {
+        Spectrum a = glm::clamp(amount_->evaluate(textureContext(si)), Spectrum(0.f),
+                                Spectrum(1.f));
+        float p = (a.x + a.y + a.z) / 3.f;
+        const Material* m = u < p ? m1_ : m2_;
+        // Reuse u for the chosen part, rescaled to [0,1).
+        float u2 = u < p ? u / p : (u - p) / (1.f - p);
+        u2 = std::min(u2, OneMinusEpsilon);
+        if (m) {
+            m->computeBSDF(si, u2, bsdf);
+        } else {
+            bsdf->init(si.ng, si.ns, si.dpdu);
+            bsdf->clear();
+        }
+    }
+
+private:
+    const Material *m1_, *m2_;
+    STex amount_;
+};
+
+// Copper, pbrt-v3's default eta and k for "metal", as RGB.
+const Spectrum kCopperEta(0.200438f, 0.924033f, 1.10221f);
+const Spectrum kCopperK(3.91295f, 2.45285f, 2.14219f);
+
+}  // namespace
+
+std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolver& tex,
+                                         const std::vector<const Material*>& materials,
+                                         const std::vector<std::string>& names,
+                                         Diagnostics& diag, bool* ok) {
+    *ok = true;
+    const ParamList& p = e.params;
+    if (e.interfaceOnly()) {
+        p.reportUnused("an interface material");
+        return nullptr;
+    }
+    auto bump = p.has("bumpmap") ? tex.floatTex(p, "bumpmap", 0.f) : nullptr;
+    bool remap = p.getBool("remaproughness", true);
+    std::unique_ptr<Material> m;
+    const std::string& t = e.type;
+    if (t == "matte") {
+        m = std::make_unique<MatteMaterial>(tex.spectrumTex(p, "Kd", Spectrum(0.5f)),
+                                            tex.floatTex(p, "sigma", 0.f), bump);
+    } else if (t == "plastic") {
+        m = std::make_unique<PlasticMaterial>(tex.spectrumTex(p, "Kd", Spectrum(0.25f)),
+                                              tex.spectrumTex(p, "Ks", Spectrum(0.25f)),
+                                              tex.floatTex(p, "roughness", 0.1f), remap, bump);
+    } else if (t == "metal") {
+        auto rough = tex.floatTex(p, "roughness", 0.01f);
+        auto u = p.has("uroughness") ? tex.floatTex(p, "uroughness", 0.f) : rough;
+        auto v = p.has("vroughness") ? tex.floatTex(p, "vroughness", 0.f) : rough;
+        m = std::make_unique<MetalMaterial>(tex.spectrumTex(p, "eta", kCopperEta),
+                                            tex.spectrumTex(p, "k", kCopperK), u, v, remap,
+                                            bump);
+    } else if (t == "glass") {
+        auto eta = p.has("eta") ? tex.floatTex(p, "eta", 1.5f) : tex.floatTex(p, "index", 1.5f);
+        m = std::make_unique<GlassMaterial>(
+            tex.spectrumTex(p, "Kr", Spectrum(1.f)), tex.spectrumTex(p, "Kt", Spectrum(1.f)), eta,
+            tex.floatTex(p, "uroughness", 0.f), tex.floatTex(p, "vroughness", 0.f), remap, bump);
+    } else if (t == "mirror") {
+        m = std::make_unique<MirrorMaterial>(tex.spectrumTex(p, "Kr", Spectrum(0.9f)), bump);
+    } else if (t == "uber") {
+        auto rough = tex.floatTex(p, "roughness", 0.1f);
+        auto u = p.has("uroughness") ? tex.floatTex(p, "uroughness", 0.f) : rough;
+        auto v = p.has("vroughness") ? tex.floatTex(p, "vroughness", 0.f) : rough;
+        auto eta = p.has("eta") ? tex.floatTex(p, "eta", 1.5f) : tex.floatTex(p, "index", 1.5f);
+        m = std::make_unique<UberMaterial>(
+            tex.spectrumTex(p, "Kd", Spectrum(0.25f)), tex.spectrumTex(p, "Ks", Spectrum(0.25f)),
+            tex.spectrumTex(p, "Kr", Spectrum(0.f)), tex.spectrumTex(p, "Kt", Spectrum(0.f)), u,
+            v, tex.spectrumTex(p, "opacity", Spectrum(1.f)), eta, remap, bump);
+    } else if (t == "substrate") {
+        m = std::make_unique<SubstrateMaterial>(
+            tex.spectrumTex(p, "Kd", Spectrum(0.5f)), tex.spectrumTex(p, "Ks", Spectrum(0.5f)),
+            tex.floatTex(p, "uroughness", 0.1f), tex.floatTex(p, "vroughness", 0.1f), remap,
+            bump);
+    } else if (t == "translucent") {
+        m = std::make_unique<TranslucentMaterial>(
+            tex.spectrumTex(p, "Kd", Spectrum(0.25f)), tex.spectrumTex(p, "Ks", Spectrum(0.25f)),
+            tex.spectrumTex(p, "reflect", Spectrum(0.5f)),
+            tex.spectrumTex(p, "transmit", Spectrum(0.5f)), tex.floatTex(p, "roughness", 0.1f),
+            remap, bump);
+    } else if (t == "mix") {
+        std::vector<std::string> parts = p.getStrings("namedmaterial1");
+        std::vector<std::string> parts2 = p.getStrings("namedmaterial2");
+        const Material* ms[2] = {nullptr, nullptr};
+        std::string wanted[2] = {parts.empty() ? "" : parts[0], parts2.empty() ? "" : parts2[0]};
+        for (int i = 0; i < 2; ++i) {
+            auto it = std::find(names.rbegin(), names.rend(), wanted[i]);
+            if (wanted[i].empty() || it == names.rend()) {
+                diag.error(e.loc, "mix material: undefined named material \"" + wanted[i] + "\"");
+                *ok = false;
+                return nullptr;
+            }
+            ms[i] = materials[size_t(names.rend() - it - 1)];
+        }
+        m = std::make_unique<MixMaterial>(ms[0], ms[1], tex.spectrumTex(p, "amount", Spectrum(0.5f)));
+    } else if (t == "fourier" || t == "hair" || t == "disney" || t == "subsurface" ||
+               t == "kdsubsurface") {
+        p.markAllUsed();
+        diag.ignored(e.loc, "material \"" + t + "\" is not supported; rendered as matte "
+                            "(Kd 0.5) instead");
+        m = std::make_unique<MatteMaterial>(std::make_shared<ConstantSpectrumTexture>(Spectrum(0.5f)),
+                                            std::make_shared<ConstantFloatTexture>(0.f), nullptr);
+    } else {
+        diag.error(e.loc, "unknown material type \"" + t + "\"");
+        *ok = false;
+        return nullptr;
+    }
+    if (e.name.empty()) p.reportUnused("material \"" + t + "\"");
+    else {
+        if (const Param* tp = p.find("type")) tp->used = true;
+        p.reportUnused("material \"" + e.name + "\"");
+    }
+    return m;
+}
+
+}  // namespace rlpbrt

@@ -1,0 +1,123 @@
+#include "render/render.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+#include <unistd.h>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace rlpbrt {
+
+namespace {
+
+double now() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+void printProgress(int pass, int spp, int totalSpp, double elapsed, double budget,
+                   double samplesPerSec) {
+    double frac = budget > 0 ? std::min(1.0, elapsed / budget)
+                             : (totalSpp > 0 ? double(spp) / totalSpp : 0.0);
+    int width = 30, filled = int(frac * width + 0.5);
+    std::string bar(size_t(filled), '=');
+    bar.resize(size_t(width), ' ');
+    double eta = frac > 0 ? elapsed / frac - elapsed : 0.0;
+    std::fprintf(stderr, "\r[%s] pass %d, %d spp, %.2f Msamples/s, %.1fs elapsed, ETA %.1fs   ",
+                 bar.c_str(), pass, spp, samplesPerSec * 1e-6, elapsed, eta);
+    std::fflush(stderr);
+}
+
+}  // namespace
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+    RenderResult result;
+    Film film(scene.filmParams, scene.filter);
+    std::vector<Bounds2i> tiles = film.sampleTiles(16);
+    int nThreads = options.nThreads > 0 ? options.nThreads
+                                        : int(std::max(1u, std::thread::hardware_concurrency()));
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(nThreads));
+    tbb::task_arena arena(nThreads);
+
+    PathIntegrator integrator(scene);
+    const int totalSpp = scene.sampler->samplesPerPixel();
+    const bool timed = options.timeBudget > 0.0;
+    // Samples per pass: one while the budget is open-ended; otherwise a few passes so that
+    // progress and cancellation stay responsive.
+    const int sppPerPass = 1;
+
+    tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers(
+        [&] { return scene.sampler->clone(); });
+    tbb::enumerable_thread_specific<PathStats> stats;
+    std::vector<std::unique_ptr<FilmTile>> tileFilms(tiles.size());
+    for (size_t i = 0; i < tiles.size(); ++i) tileFilms[i] = film.makeTile(tiles[i]);
+
+    double start = now();
+    long long samplesDone = 0;
+    long long pixelsPerPass = 0;
+    for (const auto& t : tiles) pixelsPerPass += (long long)t.area();
+    int pass = 0;
+    for (;;) {
+        int first = result.spp;
+        int count = timed ? sppPerPass : std::min(sppPerPass, totalSpp - first);
+        if (!timed && count <= 0) break;
+        arena.execute([&] {
+            tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+                Sampler& sampler = *samplers.local();
+                PathStats& st = stats.local();
+                FilmTile& tile = *tileFilms[ti];
+                const Bounds2i& b = tiles[ti];
+                for (int y = b.pMin.y; y < b.pMax.y; ++y)
+                    for (int x = b.pMin.x; x < b.pMax.x; ++x)
+                        for (int s = first; s < first + count; ++s) {
+                            sampler.startPixelSample(x, y, s);
+                            Vec2 pFilm = Vec2(float(x), float(y)) + sampler.getPixel2D();
+                            Vec2 uLens = sampler.get2D();
+                            CameraRay cr = scene.camera->generateRay(pFilm, uLens);
+                            Spectrum L(0.f);
+                            if (cr.weight > 0.f) L = integrator.Li(cr.ray, sampler, st);
+                            ++st.paths;
+                            if (!isFinite(L)) {
+                                ++st.nonFinite;
+                                L = Spectrum(0.f);
+                            } else if (isBlack(L)) {
+                                ++st.zeroRadiancePaths;
+                            }
+                            tile.addSample(pFilm, L, cr.weight);
+                        }
+            });
+        });
+        film.mergeTiles(tileFilms);
+        for (auto& t : tileFilms) t->clear();
+        result.spp += count;
+        ++pass;
+        samplesDone += pixelsPerPass * count;
+        double elapsed = now() - start;
+        if (options.onPass) options.onPass(result.spp, elapsed, film);
+        if (options.progress)
+            printProgress(pass, result.spp, totalSpp, elapsed, options.timeBudget,
+                          samplesDone / std::max(elapsed, 1e-9));
+        if (options.cancel && options.cancel->load()) {
+            result.cancelled = true;
+            break;
+        }
+        if (timed) {
+            // Stop when another pass would overrun the budget.
+            double perPass = elapsed / pass;
+            if (elapsed + perPass > options.timeBudget) break;
+        }
+    }
+    if (options.progress) std::fprintf(stderr, "\n");
+    result.seconds = now() - start;
+    for (const auto& s : stats) result.stats.add(s);
+    result.image = film.toImage();
+    return result;
+}
+
+}  // namespace rlpbrt

@@ -1,0 +1,34 @@
+// The render loop: passes of samples over film tiles on a thread pool, a time or spp budget,
+// progress reporting, and the statistics of a run.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <string>
+
+#include "render/image.h"
+#include "render/integrator.h"
+#include "render/scene.h"
+
+namespace rlpbrt {
+
+struct RenderOptions {
+    int nThreads = 0;            // 0 = all cores
+    double timeBudget = 0.0;     // seconds; > 0 renders whole passes until it is spent
+    bool progress = false;       // progress bar on stderr
+    const std::atomic<bool>* cancel = nullptr;  // set to stop after the current pass
+    // Called after each pass with the image so far (for curves and checkpoints).
+    std::function<void(int spp, double seconds, const Film& film)> onPass;
+};
+
+struct RenderResult {
+    Image image;
+    int spp = 0;            // samples per pixel actually rendered
+    double seconds = 0.0;   // render time (without parsing and building)
+    PathStats stats;
+    bool cancelled = false;
+};
+
+RenderResult render(const Scene& scene, const RenderOptions& options);
+
+}  // namespace rlpbrt
