@@ -5,7 +5,6 @@
 
 #include <array>
 #include <cstdint>
-#include <unordered_map>
 
 namespace rlpbrt {
 namespace {
@@ -57,8 +56,14 @@ bool buildTopology(const Mesh& m, Topology* t, std::string* error) {
     t->edgeFaces.clear();
     t->edgeVerts.reserve(nf * 3 / 2 + 3);
     t->edgeFaces.reserve(nf * 3 / 2 + 3);
-    std::unordered_map<uint64_t, int> edgeIds;
-    edgeIds.reserve(nf * 3 / 2 + 3);
+    // Edges keyed by their smaller endpoint: per-vertex slots (CSR) holding (other end, id),
+    // filled in face order so that edge ids follow pbrt-v3's creation order.
+    std::vector<int> slotStart(nv + 1, 0), slotFill;
+    for (const Tri& tri : m.f)
+        for (int k = 0; k < 3; ++k) ++slotStart[size_t(std::min(tri[k], tri[next3(k)])) + 1];
+    for (size_t v = 0; v < nv; ++v) slotStart[v + 1] += slotStart[v];
+    slotFill.assign(slotStart.begin(), slotStart.end() - 1);
+    std::vector<std::array<int, 2>> slots(static_cast<size_t>(slotStart[nv]));
     std::vector<int> incident(nv, 0), startFace(nv, -1);
     for (size_t fi = 0; fi < nf; ++fi) {
         const Tri& tri = m.f[fi];
@@ -66,10 +71,16 @@ bool buildTopology(const Mesh& m, Topology* t, std::string* error) {
             ++incident[size_t(tri[k])];
             startFace[size_t(tri[k])] = int(fi);
             int a = tri[k], b = tri[next3(k)];
-            uint64_t key = (uint64_t(uint32_t(std::min(a, b))) << 32) | uint32_t(std::max(a, b));
-            auto [it, isNew] = edgeIds.emplace(key, int(t->edgeVerts.size()));
-            int e = it->second;
-            if (isNew) {
+            size_t lo = size_t(std::min(a, b));
+            int hi = std::max(a, b), e = -1;
+            for (int i = slotStart[lo]; i < slotFill[lo]; ++i)
+                if (slots[size_t(i)][0] == hi) {
+                    e = slots[size_t(i)][1];
+                    break;
+                }
+            if (e < 0) {
+                e = int(t->edgeVerts.size());
+                slots[size_t(slotFill[lo]++)] = {hi, e};
                 t->edgeVerts.push_back({a, b});
                 t->edgeFaces.push_back({int(fi), -1});
             } else {
