@@ -37,10 +37,15 @@ class BSDF {
 
     // Relative index of refraction inside/outside (pbrt BSDF::eta), for Russian roulette.
     float eta() const { return eta_; }
+    // Sets the relative IOR reported by eta().
     void setEta(float eta) { eta_ = eta; }
+    // Geometric normal (world space, unit).
     const Vec3& ng() const { return ng_; }
+    // Shading normal (world space, unit).
     const Vec3& ns() const { return frame_.n; }
+    // Shading frame (s, t, n) in world space.
     const Frame& frame() const { return frame_; }
+    // The i-th lobe, 0 <= i < numComponents().
     const BxDF& component(int i) const { return bxdfs_[i]; }
 
     // Number of lobes whose flags are contained in `flags`.
@@ -50,7 +55,9 @@ class BSDF {
     // Union of the flags of all lobes.
     BxDFFlags flags() const;
 
+    // World direction to the local shading frame (z = shading normal).
     Vec3 worldToLocal(const Vec3& v) const { return frame_.toLocal(v); }
+    // Local shading-frame direction to world space.
     Vec3 localToWorld(const Vec3& v) const { return frame_.toWorld(v); }
 
     // BSDF value (1/sr) for world directions; the geometric normal decides whether reflection

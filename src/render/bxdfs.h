@@ -214,7 +214,9 @@ class BxDF {
                      SpecularReflection, SpecularTransmission, FresnelSpecular,
                      MicrofacetReflection, MicrofacetTransmission, FresnelBlend>;
 
+    // A black Lambertian reflection lobe.
     BxDF() = default;
+    // Wraps any of the lobe types above.
     template <typename T, typename = std::enable_if_t<!std::is_same_v<std::decay_t<T>, BxDF>>>
     BxDF(T&& lobe) : v_(std::forward<T>(lobe)) {}
 
@@ -224,7 +226,9 @@ class BxDF {
     BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
     // Solid-angle density of sampleF at wi (0 for specular lobes).
     float pdf(const Vec3& wo, const Vec3& wi) const;
+    // Lobe classification of the held lobe.
     BxDFFlags flags() const;
+    // True if this lobe's flags are all contained in `requested`.
     bool matchesFlags(BxDFFlags requested) const {
         return rlpbrt::matchesFlags(flags(), requested);
     }

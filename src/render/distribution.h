@@ -13,9 +13,11 @@ namespace rlpbrt {
 // back to uniform sampling (integral() still reports 0).
 class Distribution1D {
   public:
+    // Empty; must be assigned a built distribution before sampling.
     Distribution1D() = default;
     // Builds from n >= 1 values; f[i] covers [i/n, (i+1)/n).
     Distribution1D(const float* f, int n);
+    // Builds from all values of f (non-empty).
     explicit Distribution1D(const std::vector<float>& f)
         : Distribution1D(f.data(), static_cast<int>(f.size())) {}
 
@@ -53,10 +55,14 @@ class Distribution1D {
 // row by row (value (iu, iv) at f[iv * nu + iu]); u is the fast (column) coordinate.
 class Distribution2D {
   public:
+    // Empty; must be assigned a built distribution before sampling.
     Distribution2D() = default;
+    // Builds from nu * nv values (nu, nv >= 1).
     Distribution2D(const float* f, int nu, int nv);
 
+    // Number of columns (u resolution).
     int countU() const { return conditional_.empty() ? 0 : conditional_[0].count(); }
+    // Number of rows (v resolution).
     int countV() const { return static_cast<int>(conditional_.size()); }
     // Integral of the function over [0,1]^2.
     float integral() const { return marginal_.integral(); }

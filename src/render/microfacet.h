@@ -76,11 +76,15 @@ class MicrofacetDistribution {
     // Alphas below this are raised to it so that D, G and sampling stay finite.
     static constexpr float MinAlpha = 1e-4f;
 
+    // Isotropic Trowbridge-Reitz with alpha 1.
     MicrofacetDistribution() = default;
+    // alphaX / alphaY: roughness along the shading frame's s / t axes (already remapped).
     MicrofacetDistribution(MicrofacetType type, float alphaX, float alphaY);
 
     MicrofacetType type() const { return type_; }
+    // Alpha along s (after clamping to MinAlpha).
     float alphaX() const { return alphaX_; }
+    // Alpha along t (after clamping to MinAlpha).
     float alphaY() const { return alphaY_; }
 
     // Normal distribution D(wh), a density of microfacet normals w.r.t. projected solid angle.
