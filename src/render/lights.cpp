@@ -484,17 +484,17 @@ private:
         *p1 = mesh_->p[idx[1]];
         *p2 = mesh_->p[idx[2]];
     }
-    // pbrt-v3's geometric normal: cross(p1-p0, p2-p0), turned to the side of the
-    // interpolated shading normal when the mesh has normals, else flipped by flipNormals.
+    // pbrt-v3's geometric normal: cross(p1-p0, p2-p0), flipped by flipNormals, then turned
+    // to the side of the interpolated shading normal when the mesh has (non-zero) normals;
+    // the same orientation as scene.cpp's intersection normal.
     Vec3 normal(const Vec3& p0, const Vec3& p1, const Vec3& p2, float b0, float b1,
                 float b2) const {
         Vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+        if (mesh_->flipNormals) n = -n;
         if (!mesh_->n.empty()) {
             const uint32_t* idx = &mesh_->indices[3 * tri_];
             Vec3 ns = b0 * mesh_->n[idx[0]] + b1 * mesh_->n[idx[1]] + b2 * mesh_->n[idx[2]];
             if (glm::dot(n, ns) < 0.f) n = -n;
-        } else if (mesh_->flipNormals) {
-            n = -n;
         }
         return n;
     }
@@ -526,7 +526,6 @@ public:
         const Mat4& m = shape_->worldFromObject;
         glm::mat3 a(m);
         absDet_ = std::abs(glm::determinant(a));
-        swaps_ = glm::determinant(a) < 0.f;
         objArea_ = area(shape_->quadric);
         float s = 1.f;
         similar_ = isSimilarity(m, &s);
@@ -595,11 +594,13 @@ private:
         return glm::dot(r, r) > rad * rad;
     }
     // World normal of an object-space unit normal, oriented as pbrt-v3's intersection
-    // normal: normalize(cross(M dpdu, M dpdv)), flipped by flipNormals.
+    // normal (and scene.cpp's): the object normal cross(dpdu, dpdv) flipped by flipNormals
+    // (ReverseOrientation xor handedness swap), then transformed as a normal. (pbrt-v3's
+    // Sphere::Sample flips by ReverseOrientation only, which disagrees with its own
+    // intersection under a handedness swap; we follow the intersection.)
     Vec3 worldNormal(const Vec3& nObj) const {
         Vec3 n = glm::normalize(transformNormal(shape_->objectFromWorld, nObj));
-        if (swaps_ != shape_->flipNormals) n = -n;
-        return n;
+        return shape_->flipNormals ? -n : n;
     }
     // World-space area density of uniform object-space area sampling at a point with
     // unit world normal n: 1 / (objArea * J), J = |det M| / |M^T n| the area scaling.
@@ -632,7 +633,7 @@ private:
     std::shared_ptr<const QuadricShape> shape_;
     Spectrum Lemit_;
     bool twoSided_;
-    bool similar_ = false, swaps_ = false;
+    bool similar_ = false;
     float absDet_ = 1.f, objArea_ = 0.f, worldArea_ = 0.f;
 };
 
@@ -714,9 +715,7 @@ bool createAreaLights(const std::string& type, const ParamList& params, const Sh
     Spectrum sc = spectrumParam(params, "scale", Spectrum(1.f));
     bool twoSided = boolParam(params, "twosided", false);
     markIntUsed(params, "nsamples");
-    // Report once per AreaLightSource, not once per shape that uses it.
-    params.reportUnused("area light \"" + type + "\"");
-    params.markAllUsed();
+    // Unused parameters are reported by the caller, once per AreaLightSource.
     Spectrum Lemit = L * sc;
     if (shape.mesh) {
         size_t n = shape.mesh->triangleCount();

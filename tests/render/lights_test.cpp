@@ -145,15 +145,15 @@ std::shared_ptr<QuadricShape> makeQuadricShape(const Quadric& q, const Mat4& wor
     return s;
 }
 
-// The first visible point of a quadric along a world ray, with pbrt-v3's oriented normal.
+// The first visible point of a quadric along a world ray, with pbrt-v3's (and scene.cpp's)
+// intersection normal: the object-space normal flipped by flipNormals, transformed.
 bool hitQuadric(const QuadricShape& s, const Vec3& o, const Vec3& d, Vec3* p, Vec3* n) {
     Vec3 oo = transformPoint(s.objectFromWorld, o), dd = transformVector(s.objectFromWorld, d);
     QuadricHit h;
     if (!intersect(s.quadric, oo, dd, 0.f, Infinity, &h)) return false;
     *p = transformPoint(s.worldFromObject, h.p);
     Vec3 nw = glm::normalize(transformNormal(s.objectFromWorld, h.n));
-    if (swapsHandedness(s.worldFromObject) != s.flipNormals) nw = -nw;
-    *n = nw;
+    *n = s.flipNormals ? -nw : nw;
     return true;
 }
 
@@ -904,6 +904,27 @@ TEST(Lights, DiskLightIrradianceOnAxis) {
     LightSample s;
     EXPECT_FALSE(lights[0]->sampleLi(above, Vec2(0.4f, 0.4f), &s));
     EXPECT_NEAR(lights[0]->power().x, 4.f * Pi * Pi * R * R, 1e-3f);
+}
+
+TEST(Lights, QuadricNormalsFollowTheIntersectionConvention) {
+    // A mirrored disk (handedness swap, no ReverseOrientation): shapes.cpp sets flipNormals,
+    // and the intersection normal is then -z; the light must emit towards -z as well.
+    Fixture f;
+    Mat4 m = translateMatrix(Vec3(0, 0, 2)) * scaleMatrix(Vec3(-1.f, 1.f, 1.f));
+    ASSERT_TRUE(swapsHandedness(m));
+    auto qs = makeQuadricShape(makeDisk(0.f, 1.f), m, true);
+    ShapeData shape;
+    shape.quadric = qs;
+    auto lights = makeAreaLights(f, shape, {});
+    LightSampleContext below, above;
+    below.p = Vec3(0.1f, 0.f, 0.f);
+    above.p = Vec3(0.1f, 0.f, 4.f);
+    Vec3 p, n;
+    ASSERT_TRUE(hitQuadric(*qs, below.p, Vec3(0, 0, 1), &p, &n));
+    EXPECT_NEAR(n.z, -1.f, 1e-6f);
+    LightSample s;
+    EXPECT_TRUE(lights[0]->sampleLi(below, Vec2(0.2f, 0.6f), &s));
+    EXPECT_FALSE(lights[0]->sampleLi(above, Vec2(0.2f, 0.6f), &s));
 }
 
 TEST(Lights, CylinderLightPdfConsistent) {
