@@ -364,7 +364,8 @@ private:
             if (!t.isNumberLike()) return valueError(param, t, "a number");
             double v;
             if (!parseNumber(t, &v)) return false;
-            if (param->type == ParamType::Integer && (v != std::floor(v) || v < INT_MIN || v > INT_MAX)) {
+            if (param->type == ParamType::Integer &&
+                (v != std::floor(v) || v < INT_MIN || v > INT_MAX)) {
                 diag_.error(t.loc, "parameter \"" + param->name + "\" expects an integer, found " +
                                        show(t.text));
                 return false;
