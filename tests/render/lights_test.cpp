@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "render/chi2.h"
+#include "chi2.h"
 #include "render/quadrics.h"
 #include "render/sampling.h"
 #include "render/transform.h"
