@@ -26,7 +26,10 @@ LightSelector::LightSelector(const Scene& scene, const std::string& strategy) {
     if (n == 0) return;
     empty_ = false;
     std::vector<float> w(n, 1.f);
-    if (strategy != "uniform") {
+    // "spatial" (pbrt-v3's default) is served by uniform selection until a spatial
+    // distribution exists: power-proportional selection starves dim lights that matter
+    // locally (veach-mis: 6x the error of uniform at equal spp).
+    if (strategy == "power") {
         double total = 0;
         for (size_t i = 0; i < n; ++i) {
             w[i] = std::max(0.f, luminance(scene.lights[i]->power()));

@@ -29,7 +29,7 @@ struct PathStats {
 };
 
 // Chooses a light for next-event estimation: "uniform" or "power" (pbrt-v3's "spatial" is
-// served by "power" for now).
+// served by "uniform" for now).
 class LightSelector {
 public:
     LightSelector(const Scene& scene, const std::string& strategy);

@@ -174,6 +174,10 @@ bool makeLoopSubdiv(const ShapeEntity& e, Diagnostics& diag, TriangleMesh* m) {
         return false;
     }
     m->p = std::move(outP);
+    // pbrt-v3's limit normals point against the face winding (and its triangles then face
+    // their geometric normals the same way); keep that orientation so that direction-
+    // dependent BSDF terms (Fresnel) match pbrt-v3.
+    for (auto& n : outN) n = -n;
     m->n = std::move(outN);
     m->indices.assign(outIdx.begin(), outIdx.end());
     return finishMesh(e, diag, m);
