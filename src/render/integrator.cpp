@@ -21,38 +21,10 @@ Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
     return out;
 }
 
-LightSelector::LightSelector(const Scene& scene, const std::string& strategy) {
-    size_t n = scene.lights.size();
-    if (n == 0) return;
-    empty_ = false;
-    std::vector<float> w(n, 1.f);
-    // "spatial" (pbrt-v3's default) is served by uniform selection until a spatial
-    // distribution exists: power-proportional selection starves dim lights that matter
-    // locally (veach-mis: 6x the error of uniform at equal spp).
-    if (strategy == "power") {
-        double total = 0;
-        for (size_t i = 0; i < n; ++i) {
-            w[i] = std::max(0.f, luminance(scene.lights[i]->power()));
-            if (!std::isfinite(w[i])) w[i] = 0.f;
-            total += w[i];
-        }
-        if (!(total > 0)) std::fill(w.begin(), w.end(), 1.f);
-    }
-    dist_ = Distribution1D(w);
-}
-
-int LightSelector::sample(float u, float* pmf) const {
-    if (empty_) {
-        *pmf = 0.f;
-        return -1;
-    }
-    return dist_.sampleDiscrete(u, pmf);
-}
-
-float LightSelector::pmf(int light) const { return empty_ ? 0.f : dist_.discretePmf(light); }
-
 PathIntegrator::PathIntegrator(const Scene& scene)
-    : scene_(scene), lights_(scene, scene.integrator.lightSampleStrategy),
+    : scene_(scene),
+      lights_(createLightSampler(scene.integrator.lightSampleStrategy, scene.lights,
+                                 scene.boundsMin(), scene.boundsMax(), nullptr)),
       maxDepth_(scene.integrator.maxDepth), rrThreshold_(scene.integrator.rrThreshold) {}
 
 namespace {
@@ -67,7 +39,7 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
     float pmf;
-    int li = lights_.sample(uLight, &pmf);
+    int li = lights_->sample(si.p, uLight, &pmf);
     if (li < 0 || pmf == 0.f) return Spectrum(0.f);
     const Light& light = *scene_.lights[size_t(li)];
     LightSampleContext ctx{si.p, si.ng};
@@ -107,7 +79,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 if (bounces == 0 || specularBounce) {
                     L += beta * Le;
                 } else {
-                    float lightPdf = lights_.pmf(idx) * light.pdfLi(prev, ray.d, Vec3(0.f), Vec3(0.f));
+                    float lightPdf = lights_->pmf(prev.p, idx) *
+                                     light.pdfLi(prev, ray.d, Vec3(0.f), Vec3(0.f));
                     L += beta * Le * powerHeuristic(1, bsdfPdf, 1, lightPdf);
                 }
             }
@@ -120,7 +93,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 if (bounces == 0 || specularBounce) {
                     L += beta * Le;
                 } else {
-                    float lightPdf = lights_.pmf(si.light) * light.pdfLi(prev, ray.d, si.p, si.ng);
+                    float lightPdf = lights_->pmf(prev.p, si.light) *
+                                     light.pdfLi(prev, ray.d, si.p, si.ng);
                     L += beta * Le * powerHeuristic(1, bsdfPdf, 1, lightPdf);
                 }
             }

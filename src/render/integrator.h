@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "render/distribution.h"
+#include "render/light_sampler.h"
 #include "render/ray.h"
 #include "render/scene.h"
 
@@ -28,20 +28,6 @@ struct PathStats {
     }
 };
 
-// Chooses a light for next-event estimation: "uniform" or "power" (pbrt-v3's "spatial" is
-// served by "uniform" for now).
-class LightSelector {
-public:
-    LightSelector(const Scene& scene, const std::string& strategy);
-    // Index of the chosen light and its probability; -1 when there are no lights.
-    int sample(float u, float* pmf) const;
-    float pmf(int light) const;
-
-private:
-    Distribution1D dist_;
-    bool empty_ = true;
-};
-
 class PathIntegrator {
 public:
     explicit PathIntegrator(const Scene& scene);
@@ -53,7 +39,7 @@ private:
                          PathStats& stats) const;
 
     const Scene& scene_;
-    LightSelector lights_;
+    std::unique_ptr<LightSampler> lights_;
     int maxDepth_;
     float rrThreshold_;
 };

@@ -404,6 +404,12 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         is.rrThreshold = in.params.getFloat("rrthreshold", 1.f);
         is.lightSampleStrategy = in.params.getString("lightsamplestrategy", "spatial");
         if (is.maxDepth < 0) diag.error(in.loc, "maxdepth must not be negative");
+        if (is.lightSampleStrategy != "uniform" && is.lightSampleStrategy != "power" &&
+            is.lightSampleStrategy != "spatial") {
+            diag.warning(in.loc, "unknown lightsamplestrategy \"" + is.lightSampleStrategy +
+                                     "\"; using \"spatial\"");
+            is.lightSampleStrategy = "spatial";
+        }
         static const char* known[] = {"path", "volpath", "bdpt", "mlt", "sppm", "directlighting",
                                       "whitted", "ambientocclusion"};
         bool isKnown = false;

@@ -1,0 +1,143 @@
+#include "render/light_sampler.h"
+
+#include <algorithm>
+
+namespace rlpbrt {
+
+LightSampler::~LightSampler() = default;
+
+namespace {
+
+// Radical inverse of i in a prime base (Halton points inside a voxel).
+float radicalInverse(int baseIndex, uint32_t i) {
+    static const uint32_t primes[] = {2, 3, 5, 7, 11};
+    const uint32_t base = primes[baseIndex];
+    double inv = 1.0 / base, f = inv, r = 0.0;
+    while (i > 0) {
+        r += f * (i % base);
+        i /= base;
+        f *= inv;
+    }
+    return std::min(float(r), OneMinusEpsilon);
+}
+
+class TableLightSampler : public LightSampler {
+public:
+    explicit TableLightSampler(const std::vector<float>& w) : dist_(w) {}
+    int sample(const Vec3&, float u, float* pmf) const override {
+        return dist_.sampleDiscrete(u, pmf);
+    }
+    float pmf(const Vec3&, int light) const override { return dist_.discretePmf(light); }
+
+private:
+    Distribution1D dist_;
+};
+
+class NoLightSampler : public LightSampler {
+public:
+    int sample(const Vec3&, float, float* pmf) const override {
+        *pmf = 0.f;
+        return -1;
+    }
+    float pmf(const Vec3&, int) const override { return 0.f; }
+};
+
+}  // namespace
+
+SpatialLightSampler::SpatialLightSampler(const std::vector<std::unique_ptr<Light>>& lights,
+                                         const Vec3& bMin, const Vec3& bMax, int maxVoxels)
+    : lights_(lights), bMin_(bMin), bMax_(bMax) {
+    Vec3 diag = bMax - bMin;
+    float maxExtent = std::max(diag.x, std::max(diag.y, diag.z));
+    for (int i = 0; i < 3; ++i) {
+        int n = maxExtent > 0.f ? int(std::lround(diag[i] / maxExtent * maxVoxels)) : 1;
+        n_[i] = std::max(1, n);
+    }
+    voxels_ = std::vector<std::atomic<Distribution1D*>>(size_t(n_[0]) * n_[1] * n_[2]);
+    for (auto& v : voxels_) v.store(nullptr);
+}
+
+SpatialLightSampler::~SpatialLightSampler() {
+    for (auto& v : voxels_) delete v.load();
+}
+
+Distribution1D* SpatialLightSampler::compute(int ix, int iy, int iz) const {
+    Vec3 diag = bMax_ - bMin_;
+    Vec3 lo = bMin_ + diag * Vec3(float(ix) / n_[0], float(iy) / n_[1], float(iz) / n_[2]);
+    Vec3 hi = bMin_ + diag * Vec3(float(ix + 1) / n_[0], float(iy + 1) / n_[1],
+                                  float(iz + 1) / n_[2]);
+    std::vector<float> contrib(lights_.size(), 0.f);
+    constexpr int kSamples = 128;
+    for (uint32_t i = 0; i < kSamples; ++i) {
+        Vec3 t(radicalInverse(0, i), radicalInverse(1, i), radicalInverse(2, i));
+        LightSampleContext ctx{lo + t * (hi - lo), Vec3(0.f)};
+        Vec2 u(radicalInverse(3, i), radicalInverse(4, i));
+        for (size_t l = 0; l < lights_.size(); ++l) {
+            LightSample ls;
+            if (lights_[l]->sampleLi(ctx, u, &ls) && ls.pdf > 0.f) {
+                float c = luminance(ls.L) / ls.pdf;
+                if (std::isfinite(c) && c > 0.f) contrib[l] += c;
+            }
+        }
+    }
+    double sum = 0;
+    for (float c : contrib) sum += c;
+    float avg = float(sum / std::max<size_t>(1, contrib.size()));
+    float minContrib = avg > 0.f ? 0.001f * avg : 1.f;
+    for (float& c : contrib) c = std::max(c, minContrib);
+    return new Distribution1D(contrib);
+}
+
+const Distribution1D& SpatialLightSampler::lookup(const Vec3& p) const {
+    int idx[3];
+    for (int i = 0; i < 3; ++i) {
+        float extent = bMax_[i] - bMin_[i];
+        float t = extent > 0.f ? (p[i] - bMin_[i]) / extent : 0.f;
+        idx[i] = clamp(int(t * n_[i]), 0, n_[i] - 1);
+    }
+    auto& slot = voxels_[(size_t(idx[2]) * n_[1] + idx[1]) * n_[0] + idx[0]];
+    Distribution1D* d = slot.load(std::memory_order_acquire);
+    if (d) return *d;
+    // Computed deterministically, so a lost race only wastes work.
+    Distribution1D* mine = compute(idx[0], idx[1], idx[2]);
+    Distribution1D* expected = nullptr;
+    if (slot.compare_exchange_strong(expected, mine, std::memory_order_acq_rel)) {
+        computed_.fetch_add(1);
+        return *mine;
+    }
+    delete mine;
+    return *expected;
+}
+
+int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf) const {
+    return lookup(p).sampleDiscrete(u, pmf);
+}
+
+float SpatialLightSampler::pmf(const Vec3& p, int light) const {
+    return lookup(p).discretePmf(light);
+}
+
+std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,
+                                                 const std::vector<std::unique_ptr<Light>>& lights,
+                                                 const Vec3& bMin, const Vec3& bMax,
+                                                 std::string* note) {
+    if (lights.empty()) return std::make_unique<NoLightSampler>();
+    if (strategy == "uniform" || lights.size() == 1)
+        return std::make_unique<TableLightSampler>(std::vector<float>(lights.size(), 1.f));
+    if (strategy == "power") {
+        std::vector<float> w(lights.size());
+        double total = 0;
+        for (size_t i = 0; i < lights.size(); ++i) {
+            float p = luminance(lights[i]->power());
+            w[i] = std::isfinite(p) && p > 0.f ? p : 0.f;
+            total += w[i];
+        }
+        if (!(total > 0)) std::fill(w.begin(), w.end(), 1.f);
+        return std::make_unique<TableLightSampler>(w);
+    }
+    if (strategy != "spatial" && note)
+        *note = "unknown light sample strategy \"" + strategy + "\"; using \"spatial\"";
+    return std::make_unique<SpatialLightSampler>(lights, bMin, bMax);
+}
+
+}  // namespace rlpbrt

@@ -1,0 +1,57 @@
+// Light selection for next-event estimation, pbrt-v3's three strategies:
+//  - "uniform": every light equally likely;
+//  - "power": proportional to emitted power;
+//  - "spatial" (pbrt-v3's default): a voxel grid over the scene bounds; each voxel, the first
+//    time a point in it asks, estimates every light's contribution at 128 points inside it
+//    (luminance of Li / pdf, no visibility) and samples lights proportionally, with a floor
+//    of 0.1% of the average so that no light has zero probability.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/distribution.h"
+#include "render/lights.h"
+
+namespace rlpbrt {
+
+class LightSampler {
+public:
+    virtual ~LightSampler();
+    // Chooses a light for a receiving point p: its index and probability (pmf), or -1.
+    virtual int sample(const Vec3& p, float u, float* pmf) const = 0;
+    // The probability that sample() at p returns `light`.
+    virtual float pmf(const Vec3& p, int light) const = 0;
+};
+
+// Creates the sampler for a strategy name; unknown names fall back to "spatial" with a
+// message in *note.
+std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,
+                                                 const std::vector<std::unique_ptr<Light>>& lights,
+                                                 const Vec3& boundsMin, const Vec3& boundsMax,
+                                                 std::string* note);
+
+// The "spatial" strategy, exposed for tests.
+class SpatialLightSampler : public LightSampler {
+public:
+    SpatialLightSampler(const std::vector<std::unique_ptr<Light>>& lights, const Vec3& bMin,
+                        const Vec3& bMax, int maxVoxels = 64);
+    ~SpatialLightSampler() override;
+    int sample(const Vec3& p, float u, float* pmf) const override;
+    float pmf(const Vec3& p, int light) const override;
+    int voxelsComputed() const { return computed_.load(); }
+
+private:
+    const Distribution1D& lookup(const Vec3& p) const;
+    Distribution1D* compute(int ix, int iy, int iz) const;
+
+    const std::vector<std::unique_ptr<Light>>& lights_;
+    Vec3 bMin_, bMax_;
+    int n_[3];
+    mutable std::vector<std::atomic<Distribution1D*>> voxels_;
+    mutable std::atomic<int> computed_{0};
+};
+
+}  // namespace rlpbrt

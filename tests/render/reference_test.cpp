@@ -1,0 +1,108 @@
+// Correctness against pbrt-v3: every surface scene of ../shared/references/manifest.tsv is
+// rendered at 64 spp (fixed seed) with --guide=none and compared with pbrt-v3's reference.
+// Bounds (issue "path tracer" acceptance): relMSE <= 1.5x pbrt-v3's own 64-spp relMSE;
+// median block deviation <= max(2%, 1.5x pbrt-v3's own 64-spp figure); no NaN/Inf.
+#include <fstream>
+#include <sstream>
+
+#include "parser/diagnostics.h"
+#include "render/image_io.h"
+#include "render/metrics.h"
+#include "render/render.h"
+#include "render/scene.h"
+#include "render/scene_builder.h"
+#include "shared_data.h"
+
+namespace rlpbrt {
+namespace {
+
+struct ManifestRow {
+    std::string id, scene;
+    double relmse64 = 0, blockBias64 = 0;
+    bool media = false;
+};
+
+std::vector<ManifestRow> readManifest() {
+    std::vector<ManifestRow> rows;
+    std::ifstream f(test::sharedDir() + "/references/manifest.tsv");
+    std::string line;
+    std::getline(f, line);  // header
+    while (std::getline(f, line)) {
+        std::istringstream ss(line);
+        std::vector<std::string> c;
+        std::string cell;
+        while (std::getline(ss, cell, '\t')) c.push_back(cell);
+        if (c.size() < 11) continue;
+        ManifestRow r;
+        r.id = c[0];
+        r.scene = c[1];
+        r.relmse64 = std::stod(c[8]);
+        r.blockBias64 = std::stod(c[9]);
+        r.media = c[10] == "1";
+        rows.push_back(r);
+    }
+    return rows;
+}
+
+// The manifest's scene ids, known at compile time so that each is its own CTest test; a
+// missing row fails the test.
+const char* kSurfaceScenes[] = {
+    "killeroo-simple__killeroo-simple", "cornell-box__scene", "veach-mis__mis",
+    "metal-spheres-envmap__f8-22",      "caustic-glass__glass", "veach-bidir__bidir",
+    "buddha-fractal__buddha-fractal",   "breakfast__breakfast",
+    "conference-room__conference_room",
+};
+
+class ReferenceTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ReferenceTest, MatchesPbrtV3At64spp) {
+    RLPBRT_REQUIRE_SHARED();
+    std::vector<ManifestRow> rows = readManifest();
+    const ManifestRow* row = nullptr;
+    for (const auto& r : rows)
+        if (r.id == GetParam()) row = &r;
+    ASSERT_NE(row, nullptr) << "no manifest row " << GetParam();
+    ASSERT_FALSE(row->media);
+
+    Diagnostics diag;
+    diag.setStream(nullptr);
+    SceneDesc desc;
+    ASSERT_TRUE(loadSceneDesc(test::sharedDir() + "/scenes/" + row->scene, diag, &desc));
+    BuildOptions bo;
+    bo.sppOverride = 64;
+    bo.seed = 1;
+    std::unique_ptr<Scene> scene = buildScene(desc, bo, diag);
+    ASSERT_NE(scene, nullptr);
+    RenderOptions ro;
+    ro.nThreads = 1;  // CTest runs tests in parallel
+    RenderResult result = render(*scene, ro);
+    EXPECT_EQ(result.spp, 64);
+
+    Image ref;
+    std::string err;
+    ASSERT_TRUE(readImage(test::sharedDir() + "/references/" + row->id + ".exr", &ref, &err))
+        << err;
+    ASSERT_EQ(result.image.width, ref.width);
+    ASSERT_EQ(result.image.height, ref.height);
+    EXPECT_FALSE(hasNonFinite(result.image));
+    double rel = relMseTrimmed(result.image, ref);
+    double bias = blockBias(result.image, ref);
+    RecordProperty("relmse_trim", std::to_string(rel));
+    RecordProperty("block_bias", std::to_string(bias));
+    EXPECT_LE(rel, 1.5 * row->relmse64) << "pbrt-v3's own 64 spp relMSE: " << row->relmse64;
+    EXPECT_LE(bias, std::max(0.02, 1.5 * row->blockBias64))
+        << "pbrt-v3's own 64 spp block bias: " << row->blockBias64;
+    std::printf("%s: relmse %.6g (pbrt-v3 %.6g), block bias %.4g (pbrt-v3 %.4g), %.1f s\n",
+                row->id.c_str(), rel, row->relmse64, bias, row->blockBias64, result.seconds);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, ReferenceTest, ::testing::ValuesIn(kSurfaceScenes),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                             std::string n = info.param;
+                             for (char& c : n)
+                                 if (!isalnum(static_cast<unsigned char>(c))) c = '_';
+                             return n;
+                         });
+
+}  // namespace
+}  // namespace rlpbrt
