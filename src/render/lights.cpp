@@ -439,10 +439,19 @@ class TriangleLight final : public Light {
 public:
     TriangleLight(std::shared_ptr<const TriangleMesh> mesh, size_t tri, const Spectrum& L,
                   bool twoSided)
-        : mesh_(std::move(mesh)), tri_(tri), Lemit_(L), twoSided_(twoSided) {
-        Vec3 p0, p1, p2;
-        vertices(&p0, &p1, &p2);
-        area_ = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+        : Lemit_(L), twoSided_(twoSided) {
+        // The triangle's data is copied: sampling runs per shadow ray and per voxel of the
+        // spatial light distribution, and should not chase the mesh's index buffer.
+        const uint32_t* idx = &mesh->indices[3 * tri];
+        for (int k = 0; k < 3; ++k) p_[k] = mesh->p[idx[k]];
+        Vec3 c = glm::cross(p_[1] - p_[0], p_[2] - p_[0]);
+        area_ = 0.5f * glm::length(c);
+        ng_ = area_ > 0.f ? glm::normalize(c) : Vec3(0.f, 0.f, 1.f);
+        if (mesh->flipNormals) ng_ = -ng_;
+        hasNormals_ = !mesh->n.empty();
+        if (hasNormals_)
+            for (int k = 0; k < 3; ++k) n_[k] = mesh->n[idx[k]];
+        centroid_ = (p_[0] + p_[1] + p_[2]) / 3.f;
     }
     LightKind kind() const override { return LightKind::Area; }
 
@@ -452,12 +461,10 @@ public:
     bool sampleLi(const LightSampleContext& ctx, Vec2 u, LightSample* s) const override {
         *s = LightSample();
         if (!(area_ > 0.f)) return false;
-        Vec3 p0, p1, p2;
-        vertices(&p0, &p1, &p2);
         Vec2 b = sampleUniformTriangle(u);
         float b2 = 1.f - b.x - b.y;
-        Vec3 p = b.x * p0 + b.y * p1 + b2 * p2;
-        Vec3 n = normal(p0, p1, p2, b.x, b.y, b2);
+        Vec3 p = b.x * p_[0] + b.y * p_[1] + b2 * p_[2];
+        Vec3 n = normal(b.x, b.y, b2);
         Vec3 d = p - ctx.p;
         float dist2 = glm::dot(d, d);
         if (!(dist2 > 0.f)) return false;
@@ -476,31 +483,31 @@ public:
     Spectrum power() const override {
         return (twoSided_ ? 2.f : 1.f) * Lemit_ * area_ * Pi;
     }
+    float approxContribution(const Vec3& p) const override {
+        // Luminance of L times the solid angle, estimated from the centroid (at most 2 pi).
+        Vec3 d = centroid_ - p;
+        float dist2 = glm::dot(d, d);
+        float cosL = dist2 > 0.f ? glm::dot(ng_, d) / std::sqrt(dist2) : 0.f;
+        if (!twoSided_ && !hasNormals_ && cosL > 0.f) return 0.f;  // behind the emitting side
+        float omega = dist2 > 0.f ? std::min(2.f * Pi, area_ * std::abs(cosL) / dist2) : 2.f * Pi;
+        return luminance(Lemit_) * omega;
+    }
 
 private:
-    void vertices(Vec3* p0, Vec3* p1, Vec3* p2) const {
-        const uint32_t* idx = &mesh_->indices[3 * tri_];
-        *p0 = mesh_->p[idx[0]];
-        *p1 = mesh_->p[idx[1]];
-        *p2 = mesh_->p[idx[2]];
-    }
     // pbrt-v3's geometric normal: cross(p1-p0, p2-p0), flipped by flipNormals, then turned
     // to the side of the interpolated shading normal when the mesh has (non-zero) normals;
     // the same orientation as scene.cpp's intersection normal.
-    Vec3 normal(const Vec3& p0, const Vec3& p1, const Vec3& p2, float b0, float b1,
-                float b2) const {
-        Vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-        if (mesh_->flipNormals) n = -n;
-        if (!mesh_->n.empty()) {
-            const uint32_t* idx = &mesh_->indices[3 * tri_];
-            Vec3 ns = b0 * mesh_->n[idx[0]] + b1 * mesh_->n[idx[1]] + b2 * mesh_->n[idx[2]];
+    Vec3 normal(float b0, float b1, float b2) const {
+        Vec3 n = ng_;
+        if (hasNormals_) {
+            Vec3 ns = b0 * n_[0] + b1 * n_[1] + b2 * n_[2];
             if (glm::dot(n, ns) < 0.f) n = -n;
         }
         return n;
     }
 
-    std::shared_ptr<const TriangleMesh> mesh_;
-    size_t tri_;
+    Vec3 p_[3], n_[3], ng_, centroid_;
+    bool hasNormals_ = false;
     Spectrum Lemit_;
     bool twoSided_;
     float area_ = 0.f;

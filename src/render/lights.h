@@ -55,6 +55,10 @@ public:
     virtual Spectrum Le(const Vec3& dir) const;
     // Total emitted power (W, RGB), for power-proportional light selection.
     virtual Spectrum power() const = 0;
+    // A cheap, deterministic estimate of the light's unshadowed contribution at p (luminance
+    // of radiance times subtended solid angle), used to build spatial light-selection
+    // distributions; negative = not available (the caller estimates with sampleLi).
+    virtual float approxContribution(const Vec3& p) const { return -1.f; }
     // Called once the scene bounds are known (distant and infinite lights need them).
     virtual void preprocess(const Vec3& sceneCenter, float sceneRadius) {}
 };
