@@ -12,9 +12,10 @@
 #include <filesystem>
 #include <memory>
 
+#include <dlfcn.h>
+#include <mutex>
+#include <sys/stat.h>
 #include <unistd.h>
-
-#include <OpenImageIO/imageio.h>
 
 namespace rlpbrt {
 
@@ -50,6 +51,10 @@ public:
             }
             return;
         }
+        // mkstemps creates the file 0600; give the result the usual permissions.
+        mode_t mask = umask(0);
+        umask(mask);
+        fchmod(fd, 0666 & ~mask);
         ::close(fd);
         name_ = buf.data();
     }
@@ -87,19 +92,69 @@ bool writePfm(const std::string& file, const Image& img, std::string* error) {
     return true;
 }
 
-// Writes through OIIO: `data` holds img.width * img.height * 3 values of type `type`.
-bool writeOiio(const std::string& file, const OIIO::ImageSpec& spec, const void* data,
+// The OpenImageIO module (oiio/oiio_module.cpp), loaded on first use.
+struct OiioModule {
+    int (*read)(const char*, float**, int*, int*, int*, int*, char*, size_t, char*, size_t) =
+        nullptr;
+    void (*free)(float*) = nullptr;
+    int (*write)(const char*, int, int, int, const void*, int, const char* const*,
+                 const char* const*, char*, size_t) = nullptr;
+    std::string error;
+};
+
+std::string executableDir() {
+    char buf[4096];
+    ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+    if (n <= 0) return "";
+    buf[n] = '\0';
+    return std::filesystem::path(buf).parent_path().string();
+}
+
+const OiioModule& oiio() {
+    static OiioModule module;
+    static std::once_flag once;
+    std::call_once(once, [] {
+        // Next to the executable (installed or build tree), then the build tree itself.
+        std::vector<std::string> candidates;
+        if (const char* env = std::getenv("RLPBRT_OIIO_MODULE")) candidates.push_back(env);
+        candidates.push_back(executableDir() + "/librlpbrt_oiio.so");
+#ifdef RLPBRT_MODULE_DIR
+        candidates.push_back(std::string(RLPBRT_MODULE_DIR) + "/librlpbrt_oiio.so");
+#endif
+        std::string tried;
+        for (const auto& path : candidates) {
+            void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+            if (!h) {
+                tried += std::string(tried.empty() ? "" : "; ") + dlerror();
+                continue;
+            }
+            module.read = reinterpret_cast<decltype(module.read)>(dlsym(h, "rlpbrt_oiio_read"));
+            module.free = reinterpret_cast<decltype(module.free)>(dlsym(h, "rlpbrt_oiio_free"));
+            module.write = reinterpret_cast<decltype(module.write)>(dlsym(h, "rlpbrt_oiio_write"));
+            if (module.read && module.free && module.write) return;
+            module.read = nullptr;
+            tried += "; " + path + " lacks the rlpbrt_oiio symbols";
+        }
+        module.error = "cannot load the image I/O module librlpbrt_oiio.so (" + tried + ")";
+    });
+    return module;
+}
+
+// Writes through OIIO: `data` holds w * h * 3 bytes (isByte) or floats.
+bool writeOiio(const std::string& file, int w, int h, bool isByte, const void* data,
+               const std::vector<std::pair<std::string, std::string>>& metadata,
                std::string* error) {
-    auto out = OIIO::ImageOutput::create(file);
-    if (!out) return fail(error, "cannot write \"" + file + "\": " + OIIO::geterror());
-    if (!out->open(file, spec))
-        return fail(error, "cannot open \"" + file + "\": " + out->geterror());
-    if (!out->write_image(spec.format, data)) {
-        std::string msg = out->geterror();
-        out->close();
-        return fail(error, "cannot write \"" + file + "\": " + msg);
+    const OiioModule& m = oiio();
+    if (!m.write) return fail(error, m.error);
+    std::vector<const char*> keys, values;
+    for (const auto& kv : metadata) {
+        keys.push_back(kv.first.c_str());
+        values.push_back(kv.second.c_str());
     }
-    if (!out->close()) return fail(error, "cannot close \"" + file + "\": " + out->geterror());
+    char err[1024] = {0};
+    if (!m.write(file.c_str(), w, h, isByte ? 1 : 0, data, int(keys.size()), keys.data(),
+                 values.data(), err, sizeof(err)))
+        return fail(error, err);
     return true;
 }
 
@@ -121,25 +176,20 @@ bool pbrtDefaultGamma(const std::string& path) {
 }
 
 bool readImage(const std::string& path, Image* out, std::string* error, ImageFileInfo* info) {
-    // Keep alpha unassociated: we want the stored colour values, not colour * alpha.
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    if (!in) return fail(error, "cannot read image \"" + path + "\": " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    const int w = spec.width, h = spec.height, nc = spec.nchannels;
-    if (w <= 0 || h <= 0 || nc <= 0 || spec.depth > 1)
-        return fail(error, "image \"" + path + "\" has an unsupported size or layout");
-    std::vector<float> buf(size_t(w) * h * nc);
-    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, buf.data())) {
-        return fail(error, "cannot read pixels of \"" + path + "\": " + in->geterror());
-    }
+    const OiioModule& m = oiio();
+    if (!m.read) return fail(error, m.error);
+    float* raw = nullptr;
+    int w = 0, h = 0, nc = 0, eightBit = 0;
+    char format[64] = {0}, err[1024] = {0};
+    if (!m.read(path.c_str(), &raw, &w, &h, &nc, &eightBit, format, sizeof(format), err,
+                sizeof(err)))
+        return fail(error, err);
+    std::unique_ptr<float, void (*)(float*)> buf(raw, m.free);
     if (info) {
-        info->format = in->format_name();
+        info->format = format;
         info->fileChannels = nc;
-        info->eightBit = spec.format == OIIO::TypeDesc::UINT8;
+        info->eightBit = eightBit != 0;
     }
-    in->close();
 
     Image img;
     img.width = w;
@@ -147,7 +197,7 @@ bool readImage(const std::string& path, Image* out, std::string* error, ImageFil
     img.channels = 3;
     img.pixels.resize(size_t(w) * h * 3);
     for (size_t i = 0; i < size_t(w) * h; ++i) {
-        const float* src = &buf[i * nc];
+        const float* src = buf.get() + i * size_t(nc);
         float* dst = &img.pixels[i * 3];
         if (nc < 3) {
             dst[0] = dst[1] = dst[2] = src[0];  // grey (+ alpha)
@@ -198,17 +248,12 @@ bool writeImage(const std::string& path, const Image& img,
             float e = linearToSrgb(std::clamp(clean[i], 0.f, 1.f));
             bytes[i] = uint8_t(std::clamp(std::floor(255.f * e + 0.5f), 0.f, 255.f));
         }
-        OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
-        spec.attribute("oiio:ColorSpace", "sRGB");
-        for (const auto& kv : metadata) spec.attribute(kv.first, kv.second);
-        ok = writeOiio(tmp.name(), spec, bytes.data(), error);
+        ok = writeOiio(tmp.name(), img.width, img.height, true, bytes.data(), metadata, error);
     } else {
-        OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-        if (ext == ".exr") {
-            spec.attribute("compression", "zip");
-            for (const auto& kv : metadata) spec.attribute(kv.first, kv.second);
-        }
-        ok = writeOiio(tmp.name(), spec, clean.data(), error);
+        ok = writeOiio(tmp.name(), img.width, img.height, false, clean.data(),
+                       ext == ".exr" ? metadata
+                                     : std::vector<std::pair<std::string, std::string>>(),
+                       error);
     }
     if (!ok) return false;
 
