@@ -1,0 +1,46 @@
+#include "guiding/directional.h"
+
+#include <algorithm>
+
+namespace rlpbrt::guiding {
+
+StrataLayout::StrataLayout(int cols, int rows) : cols_(cols), rows_(rows) {
+    centres_.resize(static_cast<size_t>(cols) * static_cast<size_t>(rows));
+    for (int row = 0; row < rows; ++row) {
+        // Centre in the map's coordinates: cos(theta) and phi at the middle of the cell.
+        double z = (row + 0.5) / rows;
+        double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        for (int col = 0; col < cols; ++col) {
+            double phi = 2.0 * kPi * (col + 0.5) / cols;
+            centres_[static_cast<size_t>(row * cols + col)] =
+                glm::vec3(static_cast<float>(r * std::cos(phi)),
+                          static_cast<float>(r * std::sin(phi)), static_cast<float>(z));
+        }
+    }
+}
+
+void buildStrataCdf(const double* q, int n, double epsilon, float* cdf) {
+    double sum = 0.0;
+    for (int j = 0; j < n; ++j) sum += q[j];
+    const bool uniform = !(sum > 0.0) || !std::isfinite(sum);
+    const double floor = epsilon / n, scale = uniform ? 0.0 : (1.0 - epsilon) / sum;
+    double acc = 0.0;
+    cdf[0] = 0.f;
+    for (int j = 0; j < n; ++j) {
+        acc += uniform ? 1.0 / n : q[j] * scale + floor;
+        cdf[j + 1] = static_cast<float>(std::min(acc, 1.0));
+    }
+    cdf[n] = 1.f;
+}
+
+int sampleStrataCdf(const float* cdf, int n, float u) {
+    // First entry of cdf[1..n] strictly greater than u; zero-width strata are skipped.
+    const float* it = std::upper_bound(cdf + 1, cdf + n + 1, u);
+    int j = static_cast<int>(it - (cdf + 1));
+    if (j < n) return j;
+    j = n - 1;  // u >= 1 (outside the contract): the last stratum of non-zero probability
+    while (j > 0 && !(cdf[j + 1] > cdf[j])) --j;
+    return j;
+}
+
+}  // namespace rlpbrt::guiding

@@ -1,0 +1,103 @@
+// Directional building blocks of the guiding layer: an orthonormal frame around a normal, the
+// equal-area stratification of the hemisphere (cylindrical equal-area map) and piecewise-
+// constant CDFs over the strata. Standard library and GLM only.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace rlpbrt::guiding {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr float kTwoPiF = 6.28318530717958647692f;
+
+// Orthonormal basis with z along a unit normal (Duff et al. 2017, "Building an Orthonormal
+// Basis, Revisited"); same construction as the render layer's Frame, kept here so the guiding
+// layer does not depend on src/render/.
+struct HemiFrame {
+    glm::vec3 s, t, n;
+    // Frame around the unit vector n (local +z = n).
+    static HemiFrame fromZ(const glm::vec3& n) {
+        float sign = std::copysign(1.f, n.z);
+        float a = -1.f / (sign + n.z);
+        float b = n.x * n.y * a;
+        return HemiFrame{glm::vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x),
+                         glm::vec3(b, sign + n.y * n.y * a, -n.y), n};
+    }
+    // World vector -> local coordinates (z along n).
+    glm::vec3 toLocal(const glm::vec3& v) const {
+        return glm::vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n));
+    }
+    // Local coordinates -> world vector.
+    glm::vec3 toWorld(const glm::vec3& v) const { return s * v.x + t * v.y + n * v.z; }
+};
+
+// Equal-area strata of the hemisphere z > 0 through the cylindrical equal-area map
+// (a, b) in [0,1)^2 -> cos(theta) = a, phi = 2 pi b. `cols` strata in phi, `rows` strata in
+// cos(theta); stratum index j = row * cols + col. Every stratum subtends exactly
+// 2 pi / count() steradians.
+class StrataLayout {
+public:
+    // cols, rows in [1, 64] (the caller validates).
+    StrataLayout(int cols, int rows);
+
+    int cols() const { return cols_; }
+    int rows() const { return rows_; }
+    int count() const { return cols_ * rows_; }
+    // Solid angle of one stratum in steradians: 2 pi / count().
+    double stratumSolidAngle() const { return 2.0 * kPi / count(); }
+
+    // Stratum of a unit local direction; -1 if local.z <= 0 or NaN (or phi is NaN).
+    // cos(theta) = 1 and phi = 2 pi are clamped into the last row/column.
+    int stratumOf(const glm::vec3& local) const {
+        if (!(local.z > 0.f)) return -1;  // also rejects NaN
+        int row = static_cast<int>(local.z * static_cast<float>(rows_));
+        row = row < rows_ - 1 ? row : rows_ - 1;
+        int col = 0;
+        if (cols_ > 1) {
+            float phi = std::atan2(local.y, local.x);
+            if (phi < 0.f) phi += kTwoPiF;
+            if (!(phi >= 0.f)) return -1;  // NaN components
+            col = static_cast<int>(phi * (static_cast<float>(cols_) / kTwoPiF));
+            col = col < 0 ? 0 : (col < cols_ - 1 ? col : cols_ - 1);
+        }
+        return row * cols_ + col;
+    }
+
+    // Uniform (per solid angle) unit local direction inside stratum j from u in [0,1)^2:
+    // u.x places cos(theta) within the row, u.y places phi within the column.
+    glm::vec3 sampleStratum(int j, glm::vec2 u) const {
+        int row = j / cols_, col = j - row * cols_;
+        float z = (static_cast<float>(row) + u.x) / static_cast<float>(rows_);
+        z = z < 1.f ? z : 1.f;
+        float r = std::sqrt(std::max(0.f, 1.f - z * z));
+        float phi = kTwoPiF * (static_cast<float>(col) + u.y) / static_cast<float>(cols_);
+        return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
+    }
+
+    // Local unit direction of stratum j's centre (its representative direction).
+    const glm::vec3& centre(int j) const { return centres_[static_cast<size_t>(j)]; }
+
+private:
+    int cols_, rows_;
+    std::vector<glm::vec3> centres_;
+};
+
+// Builds the CDF of one stratum table: P_j = (1 - epsilon) q_j / sum(q) + epsilon / n, summed
+// in double; uniform if sum(q) is 0 or not finite. cdf has n + 1 entries, cdf[0] = 0 and
+// cdf[n] = 1 exactly; entries are non-decreasing. q must be finite and >= 0.
+void buildStrataCdf(const double* q, int n, double epsilon, float* cdf);
+
+// Stratum selected by u in [0,1) on a CDF of n strata: the j with cdf[j] <= u < cdf[j+1]
+// (never a stratum of zero probability); clamped to n - 1 for u >= 1.
+int sampleStrataCdf(const float* cdf, int n, float u);
+
+// Probability of stratum j under the CDF (cdf[j+1] - cdf[j]): exactly the measure of the u
+// values sampleStrataCdf maps to j.
+inline float strataProbability(const float* cdf, int j) { return cdf[j + 1] - cdf[j]; }
+
+}  // namespace rlpbrt::guiding

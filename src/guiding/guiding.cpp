@@ -1,0 +1,147 @@
+#include "guiding/guiding.h"
+
+#include <cerrno>
+#include <cfloat>
+#include <cmath>
+#include <cstdlib>
+
+#include "guiding/hemi.h"
+
+namespace rlpbrt::guiding {
+
+GuidingField::~GuidingField() = default;
+
+float GuidingField::irradianceEstimate(int region, const glm::vec3& n) const {
+    return scatteredEstimate(region,
+                             [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
+}
+
+namespace {
+
+// Parses a whole string as a finite double.
+bool parseDouble(const std::string& s, double* out) {
+    if (s.empty()) return false;
+    const char* begin = s.c_str();
+    char* end = nullptr;
+    errno = 0;
+    double v = std::strtod(begin, &end);
+    if (end != begin + s.size() || errno == ERANGE || !std::isfinite(v)) return false;
+    *out = v;
+    return true;
+}
+
+// Parses a whole string of decimal digits as an unsigned integer <= maxValue.
+bool parseUnsigned(const std::string& s, uint64_t maxValue, uint64_t* out) {
+    if (s.empty() || s.size() > 19) return false;
+    uint64_t v = 0;
+    for (char c : s) {
+        if (c < '0' || c > '9') return false;
+        v = v * 10 + uint64_t(c - '0');
+    }
+    if (v > maxValue) return false;
+    *out = v;
+    return true;
+}
+
+// Reads the hemi parameters; false and *error on an unknown key or a bad value.
+bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParams* hp,
+                     double* maxMiB, std::string* error) {
+    auto bad = [&](const std::string& key, const std::string& value, const char* expected) {
+        *error = "guiding backend 'hemi': bad value '" + value + "' for parameter '" + key +
+                 "' (expected " + expected + ")";
+        return false;
+    };
+    for (const auto& [key, value] : params) {
+        double d = 0.0;
+        uint64_t u = 0;
+        if (key == "alpha") {
+            if (value == "visits") {
+                hp->alphaVisits = true;
+            } else if (parseDouble(value, &d) && d > 0.0 && d <= 1.0) {
+                hp->alphaVisits = false;
+                hp->fixedAlpha = d;
+            } else {
+                return bad(key, value, "'visits' or a number in (0, 1]");
+            }
+        } else if (key == "strata") {
+            const char* expected = "WxH or N with integers in 1..64";
+            size_t x = value.find_first_of("xX");
+            uint64_t w = 0, h = 0;
+            if (x == std::string::npos) {
+                if (!parseUnsigned(value, 64, &w)) return bad(key, value, expected);
+                h = w;
+            } else if (!parseUnsigned(value.substr(0, x), 64, &w) ||
+                       !parseUnsigned(value.substr(x + 1), 64, &h)) {
+                return bad(key, value, expected);
+            }
+            if (w < 1 || h < 1) return bad(key, value, expected);
+            hp->cols = int(w);
+            hp->rows = int(h);
+        } else if (key == "points") {
+            if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
+                return bad(key, value, "an integer in 1..67108864");
+            hp->points = u;
+        } else if (key == "normal-angle") {
+            if (!parseDouble(value, &d) || !(d > 0.0) || !(d < 180.0))
+                return bad(key, value, "degrees in (0, 180)");
+            hp->normalAngleDeg = d;
+        } else if (key == "init") {
+            if (!parseDouble(value, &d) || !(d > 0.0) || d > double(FLT_MAX))
+                return bad(key, value, "a positive number <= 3.4e38");
+            hp->init = d;
+        } else if (key == "epsilon") {
+            if (!parseDouble(value, &d) || d < 0.0 || d > 1.0)
+                return bad(key, value, "a number in [0, 1]");
+            hp->epsilon = d;
+        } else if (key == "knn") {
+            if (!parseUnsigned(value, 64, &u) || u < 1)
+                return bad(key, value, "an integer in 1..64");
+            hp->knn = int(u);
+        } else if (key == "max-mb") {
+            if (!parseDouble(value, &d) || !(d > 0.0)) return bad(key, value, "a positive number");
+            *maxMiB = d;
+        } else if (key == "mix") {
+            // Consumed by the integrator.
+        } else {
+            *error = "guiding backend 'hemi': unknown parameter '" + key +
+                     "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
+                     "max-mb, mix)";
+            return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace
+
+std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
+                                                 const SceneInfo& scene, std::string* error) {
+    std::string scratch;
+    if (!error) error = &scratch;
+    error->clear();
+    if (config.backend == "none") return nullptr;
+    if (config.backend == "hemi") {
+        HemiParams hp;
+        double maxMiB = 4096.0;
+        if (!parseHemiParams(config.params, &hp, &maxMiB, error)) return nullptr;
+        if (!scene.samplePoint) {
+            *error = "guiding backend 'hemi': the scene provides no surface sampler";
+            return nullptr;
+        }
+        double mib = hemiEstimatedBytes(hp) / (1024.0 * 1024.0);
+        if (mib > maxMiB) {
+            char buf[256];
+            std::snprintf(buf, sizeof(buf),
+                          "guiding backend 'hemi': %llu points with %dx%d strata need about "
+                          "%.0f MiB, more than max-mb=%g",
+                          (unsigned long long)hp.points, hp.cols, hp.rows, mib, maxMiB);
+            *error = buf;
+            return nullptr;
+        }
+        return std::make_unique<HemiField>(hp, scene);
+    }
+    *error = "unknown guiding backend '" + config.backend + "' (available: none, hemi)";
+    return nullptr;
+}
+
+}  // namespace rlpbrt::guiding

@@ -1,0 +1,108 @@
+// The guiding layer's interface: a learned incident-radiance field that a path integrator
+// queries per vertex (lookup, sample, pdf), feeds with training targets (record) and updates
+// between passes (endPass), after Dahm & Keller 2017, "Learning Light Transport the
+// Reinforced Way". Backends are created by name through createGuidingField, the only place
+// that names them. Depends on the standard library, GLM, TBB and nanoflann only.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <glm/glm.hpp>
+
+namespace rlpbrt::guiding {
+
+// Configuration from --guide=NAME and repeated --guide-param key=value.
+struct GuideConfig {
+    std::string backend = "none";
+    std::map<std::string, std::string> params;
+};
+
+// What the field may know of the scene: its bounds and a way to draw points uniformly over
+// the scene's surface area (u in [0,1)^3 -> point and unit geometric normal; false if the
+// scene has no surface). Nothing else (no materials, no render types).
+struct SceneInfo {
+    glm::vec3 boundsMin{0.f}, boundsMax{0.f};
+    double totalArea = 0.0;  // total surface area in scene units squared
+    std::function<bool(const glm::vec3& u, glm::vec3* p, glm::vec3* n)> samplePoint;
+};
+
+// Counters of the learning process, cumulative over all passes.
+struct GuidingStats {
+    uint64_t passes = 0;            // completed endPass() calls
+    uint64_t records = 0;           // targets applied to the field
+    uint64_t rejectedTargets = 0;   // NaN, Inf or negative targets dropped by record()
+    uint64_t rejectedRecords = 0;   // bad slot/region or direction outside the hemisphere
+};
+
+// A learned directional distribution per spatial region. lookup/sample/pdf/scattered/
+// irradianceEstimate are const and thread-safe; they read the policy frozen at the last
+// endPass() and must not run concurrently with endPass(). record() is thread-safe across
+// distinct slots.
+class GuidingField {
+public:
+    virtual ~GuidingField();
+
+    // Region for a vertex at p whose hemisphere of interest is around unit normal n (the
+    // integrator passes the shading normal flipped to wo's side). -1 = no data: use the BSDF.
+    virtual int lookup(const glm::vec3& p, const glm::vec3& n) const = 0;
+    // Samples a unit world direction from the frozen policy of `region` (u places it inside
+    // the stratum chosen by uStratum; all in [0,1)); *pdf is per steradian and equals
+    // pdf(region, result) (> 0 for a valid region; 0 and a zero vector for an invalid one).
+    virtual glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const = 0;
+    // Solid-angle pdf of sample() for any world direction (0 outside the region's hemisphere
+    // and for an invalid region); w need not be normalised.
+    virtual float pdf(int region, const glm::vec3& w) const = 0;
+    // The bootstrap part of Eq. 1 at a region y: (2pi/n) * sum_j Q(y,j) * fcos(w_j), where
+    // fcos(world dir) returns f_s(w_j, y, -w) * max(0, cos) as a scalar (luminance). w_j are
+    // the unit world directions of the stratum centres. Non-finite or negative fcos values
+    // count as 0; the result is finite and >= 0 (0 for an invalid region).
+    virtual float scatteredEstimate(int region,
+                                    const std::function<float(const glm::vec3&)>& fcos) const = 0;
+    // (2pi/n) * sum_j Q(y,j) * max(0, dot(w_j, n)): the irradiance estimate at a region for a
+    // unit shading normal n, so a Lambertian y of albedo rho has scattered = rho / pi * this.
+    // Same result as scatteredEstimate with fcos = max(0, dot(w, n)), without the callbacks.
+    virtual float irradianceEstimate(int region, const glm::vec3& n) const;
+
+    // Learning: during a pass, record that from `region` the direction w received target T
+    // (T = Le + scatteredEstimate at the next vertex, or the environment radiance). `slot` is
+    // the caller's work-item index (film tile) in [0, numSlots): records are merged in slot
+    // order at endPass() so results do not depend on thread scheduling. Thread-safe across
+    // slots; one thread at a time per slot.
+    virtual void beginPass(int numSlots) = 0;
+    // Records one target (radiance, luminance); rejected if not finite or negative.
+    virtual void record(int slot, int region, const glm::vec3& w, float target) = 0;
+    // Applies the recorded targets (Eq. 1 with alpha = 1/(1+visits) by default, i.e. the
+    // batch running mean of the notes section 4, or a fixed alpha) and rebuilds the CDFs.
+    virtual void endPass() = 0;
+
+    // Memory of the learned data in bytes (tables, CDFs, points, kd-tree, record buffers).
+    virtual size_t bytes() const = 0;
+    // One line for logs: points, strata, parameters, memory, counters.
+    virtual std::string describe() const = 0;
+    // Learning counters (cumulative).
+    virtual GuidingStats stats() const = 0;
+};
+
+// The factory: the only place that names backends. "none" returns nullptr with *error empty
+// (parameters are ignored). Unknown backend or parameter, or a bad value => nullptr and a
+// message in *error. Backend "hemi" parameters:
+//   alpha        "visits" (default: 1/(1+visits), batch running mean) or a number in (0,1]
+//   strata       "WxH" (default 8x8): W columns in phi, H rows in cos(theta), each 1..64;
+//                "N" means NxN
+//   points       surface samples, 1..2^26 (default 8192); each gives two hemispheres (n, -n)
+//   normal-angle admissible normal deviation in degrees, (0, 180) (default 30)
+//   init         initial Q, positive and <= 3.4e38 (default 1e-3)
+//   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)
+//   knn          nearest points checked for an admissible normal, 1..64 (default 8)
+//   max-mb       refuse configurations whose tables would exceed this many MiB
+//                (default 4096)
+//   mix          consumed by the integrator; accepted and ignored here
+std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
+                                                 const SceneInfo& scene, std::string* error);
+
+}  // namespace rlpbrt::guiding

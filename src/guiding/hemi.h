@@ -1,0 +1,114 @@
+// The `hemi` guiding backend (Dahm & Keller 2017): points distributed uniformly over the
+// scene surface, two hemispheres per point (around n and -n), each cut into equal-area
+// strata holding Q, the learned incident radiance; a kd-tree finds the nearest point with an
+// admissible normal. Learning is batched per pass (running mean or fixed alpha) and the
+// sampling CDFs are rebuilt between passes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "guiding/directional.h"
+#include "guiding/guiding.h"
+
+namespace rlpbrt::guiding {
+
+// Validated parameters of the hemi backend (see createGuidingField for their meaning).
+struct HemiParams {
+    bool alphaVisits = true;     // alpha = 1/(1 + visits) if true, else fixedAlpha
+    double fixedAlpha = 1.0;     // in (0, 1]
+    int cols = 8, rows = 8;      // strata in phi and in cos(theta)
+    uint64_t points = 8192;      // surface samples (two hemispheres each)
+    double normalAngleDeg = 30;  // admissible normal deviation
+    double init = 1e-3;          // initial Q
+    double epsilon = 0.1;        // uniform share of every CDF
+    int knn = 8;                 // neighbours checked by lookup
+};
+
+// Estimated bytes of a hemi field with these parameters (tables, CDFs, points, kd-tree).
+double hemiEstimatedBytes(const HemiParams& params);
+
+class HemiField final : public GuidingField {
+public:
+    // Draws params.points surface samples with scene.samplePoint (Halton sequence in bases
+    // 2, 3, 5; failed or degenerate samples are skipped) and builds the kd-tree.
+    HemiField(const HemiParams& params, const SceneInfo& scene);
+    ~HemiField() override;
+
+    int lookup(const glm::vec3& p, const glm::vec3& n) const override;
+    glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const override;
+    float pdf(int region, const glm::vec3& w) const override;
+    float scatteredEstimate(int region,
+                            const std::function<float(const glm::vec3&)>& fcos) const override;
+    float irradianceEstimate(int region, const glm::vec3& n) const override;
+    void beginPass(int numSlots) override;
+    void record(int slot, int region, const glm::vec3& w, float target) override;
+    void endPass() override;
+    size_t bytes() const override;
+    std::string describe() const override;
+    GuidingStats stats() const override;
+
+    // Inspection (tests, tools).
+    // Number of regions (hemispheres): twice the number of accepted surface points.
+    int numRegions() const { return static_cast<int>(normals_.size() * 2); }
+    const StrataLayout& layout() const { return layout_; }
+    const HemiParams& params() const { return params_; }
+    // Surface position and unit hemisphere normal of a region.
+    glm::vec3 regionPosition(int region) const { return positions_[size_t(region) / 2]; }
+    glm::vec3 regionNormal(int region) const {
+        glm::vec3 n = normals_[size_t(region) / 2];
+        return (region & 1) ? -n : n;
+    }
+    // Stratum of world direction w in a region's hemisphere, -1 outside.
+    int stratumOf(int region, const glm::vec3& w) const;
+    // Learned Q and visit count of one stratum.
+    double q(int region, int stratum) const { return q_[index(region, stratum)]; }
+    uint64_t visits(int region, int stratum) const { return visits_[index(region, stratum)]; }
+    // Raw tables, for bitwise comparisons: Q, visits, CDFs (n + 1 floats per region).
+    const std::vector<double>& qTable() const { return q_; }
+    const std::vector<uint64_t>& visitTable() const { return visits_; }
+    const std::vector<float>& cdfTable() const { return cdf_; }
+
+private:
+    struct Record {
+        uint32_t region;
+        uint16_t stratum;
+        float target;
+    };
+    struct alignas(64) SlotBuffer {
+        std::vector<Record> records;
+        uint64_t rejectedTargets = 0;
+        uint64_t rejectedRecords = 0;
+    };
+    struct KdTree;  // nanoflann index over positions_, defined in hemi.cpp
+
+    size_t index(int region, int stratum) const {
+        return size_t(region) * size_t(strata_) + size_t(stratum);
+    }
+    bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
+    const float* cdf(int region) const { return &cdf_[size_t(region) * size_t(strata_ + 1)]; }
+    // Applies one region's records [begin, end) and rebuilds its CDF.
+    void applyRegion(int region, const Record* begin, const Record* end, double* sums,
+                     uint64_t* counts);
+
+    HemiParams params_;
+    StrataLayout layout_;
+    int strata_;
+    float cosMaxAngle_;
+    std::vector<glm::vec3> positions_;  // one per surface sample
+    std::vector<glm::vec3> normals_;    // unit geometric normal per surface sample
+    std::unique_ptr<KdTree> tree_;
+    std::vector<double> q_;          // Q per (region, stratum)
+    std::vector<uint64_t> visits_;   // applied targets per (region, stratum)
+    std::vector<float> cdf_;         // frozen policy: strata_ + 1 entries per region
+    std::vector<SlotBuffer> slots_;  // per-pass record buffers
+    std::vector<uint64_t> regionStart_;  // endPass scratch: counting sort by region
+    std::vector<Record> merged_;         // endPass scratch: records grouped by region
+    GuidingStats stats_;
+    uint64_t attempts_ = 0;  // samplePoint calls made at construction
+};
+
+}  // namespace rlpbrt::guiding

@@ -1,0 +1,149 @@
+// Tests of the guiding layer's directional building blocks: the equal-area hemisphere strata
+// and the stratum CDFs.
+#include "guiding/directional.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "render/chi2.h"
+
+namespace rlpbrt::guiding {
+namespace {
+
+// Uniform direction on the sphere by normalising a Gaussian vector: independent of the
+// cylindrical map under test.
+glm::vec3 gaussianDirection(std::mt19937_64& rng) {
+    std::normal_distribution<float> g;
+    glm::vec3 v;
+    do {
+        v = glm::vec3(g(rng), g(rng), g(rng));
+    } while (glm::length(v) < 1e-6f);
+    return glm::normalize(v);
+}
+
+TEST(StrataLayout, SampleLandsInItsStratumAndCentresInside) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (auto [cols, rows] : {std::pair{1, 1}, {3, 5}, {8, 8}, {64, 64}, {1, 64}, {64, 1}}) {
+        StrataLayout layout(cols, rows);
+        ASSERT_EQ(layout.count(), cols * rows);
+        int mismatches = 0;
+        for (int j = 0; j < layout.count(); ++j) {
+            EXPECT_EQ(layout.stratumOf(layout.centre(j)), j) << cols << "x" << rows;
+            EXPECT_NEAR(glm::length(layout.centre(j)), 1.f, 1e-5f);
+            for (int k = 0; k < 8; ++k) {
+                glm::vec3 w = layout.sampleStratum(j, glm::vec2(uni(rng), uni(rng)));
+                EXPECT_NEAR(glm::length(w), 1.f, 1e-5f);
+                EXPECT_GE(w.z, 0.f);
+                // Float rounding may put a sample exactly on a stratum edge into its neighbour.
+                if (layout.stratumOf(w) != j) ++mismatches;
+            }
+        }
+        EXPECT_LE(mismatches, 2) << cols << "x" << rows;
+    }
+}
+
+TEST(StrataLayout, IndexEdgesClamp) {
+    StrataLayout layout(8, 8);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, 0, 1)), 7 * 8);            // cos = 1: last row
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, 0, 1.0000001f)), 7 * 8);   // cos slightly > 1
+    EXPECT_EQ(layout.stratumOf(glm::vec3(1, -1e-30f, 1e-3f)), 7);      // phi just below 2 pi
+    EXPECT_EQ(layout.stratumOf(glm::vec3(1, 0, 1e-3f)), 0);            // phi = 0
+    EXPECT_EQ(layout.stratumOf(glm::vec3(1, -0.f, 1e-3f)), 0);         // phi = -0
+    EXPECT_EQ(layout.stratumOf(glm::vec3(1, 0, 0)), -1);               // horizon
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, 0, -1)), -1);              // below
+    EXPECT_EQ(layout.stratumOf(glm::vec3(NAN, 0, 0.5f)), -1);              // NaN phi
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, 0, NAN)), -1);
+    StrataLayout one(1, 1);
+    EXPECT_EQ(one.stratumOf(glm::vec3(0, 0, 1)), 0);
+    EXPECT_EQ(one.stratumOf(glm::vec3(-1, -1e-30f, 1e-6f)), 0);
+}
+
+TEST(StrataLayout, StrataHaveEqualSolidAngle) {
+    // Uniform sphere directions (Gaussian construction) must fill the 8x6 strata equally.
+    StrataLayout layout(8, 6);
+    std::mt19937_64 rng(11);
+    const int n = 200000;
+    std::vector<double> observed(size_t(layout.count()) + 1, 0.0);
+    for (int i = 0; i < n; ++i) {
+        int j = layout.stratumOf(gaussianDirection(rng));
+        observed[j < 0 ? size_t(layout.count()) : size_t(j)] += 1.0;
+    }
+    std::vector<double> expected(observed.size(), 0.5 * n / layout.count());
+    expected.back() = 0.5 * n;  // lower hemisphere
+    chi2::Result r = chi2::testCounts(observed, expected);
+    EXPECT_TRUE(r.passed) << r.message;
+}
+
+TEST(StrataCdf, UniformForZeroOrNonFiniteSums) {
+    std::vector<double> q(5, 0.0);
+    std::vector<float> cdf(6);
+    buildStrataCdf(q.data(), 5, 0.1, cdf.data());
+    for (int j = 0; j < 5; ++j) EXPECT_FLOAT_EQ(strataProbability(cdf.data(), j), 0.2f);
+    q.assign(5, 1e308);  // the sum overflows to Inf
+    buildStrataCdf(q.data(), 5, 0.1, cdf.data());
+    for (int j = 0; j < 5; ++j) EXPECT_FLOAT_EQ(strataProbability(cdf.data(), j), 0.2f);
+    EXPECT_EQ(cdf[0], 0.f);
+    EXPECT_EQ(cdf[5], 1.f);
+}
+
+TEST(StrataCdf, EpsilonFloorAndProportionality) {
+    std::vector<double> q = {0.0, 1.0, 3.0, 0.0};
+    std::vector<float> cdf(5);
+    buildStrataCdf(q.data(), 4, 0.2, cdf.data());
+    EXPECT_NEAR(strataProbability(cdf.data(), 0), 0.05f, 1e-7f);
+    EXPECT_NEAR(strataProbability(cdf.data(), 1), 0.8f * 0.25f + 0.05f, 1e-7f);
+    EXPECT_NEAR(strataProbability(cdf.data(), 2), 0.8f * 0.75f + 0.05f, 1e-7f);
+    EXPECT_NEAR(strataProbability(cdf.data(), 3), 0.05f, 1e-7f);
+    EXPECT_EQ(cdf[4], 1.f);
+}
+
+TEST(StrataCdf, NeverSelectsZeroProbabilityStratum) {
+    std::vector<double> q = {0.0, 2.0, 0.0, 0.0, 1.0, 0.0};
+    std::vector<float> cdf(7);
+    buildStrataCdf(q.data(), 6, 0.0, cdf.data());
+    for (float u : {0.f, 1e-9f, 0.3f, 2.f / 3.f, 0.99999994f, 1.f, 2.f}) {
+        int j = sampleStrataCdf(cdf.data(), 6, u);
+        EXPECT_TRUE(j == 1 || j == 4) << "u = " << u << " gave " << j;
+    }
+    EXPECT_EQ(sampleStrataCdf(cdf.data(), 6, 0.f), 1);
+    EXPECT_EQ(sampleStrataCdf(cdf.data(), 6, 0.99999994f), 4);
+}
+
+TEST(StrataCdf, SampleFrequenciesMatchProbabilities) {
+    std::vector<double> q = {1.0, 5.0, 0.5, 2.0, 0.0, 8.0, 1.0, 0.25};
+    std::vector<float> cdf(9);
+    buildStrataCdf(q.data(), 8, 0.1, cdf.data());
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    const int n = 100000;
+    std::vector<double> observed(8, 0.0), expected(8);
+    for (int i = 0; i < n; ++i) observed[size_t(sampleStrataCdf(cdf.data(), 8, uni(rng)))] += 1;
+    for (int j = 0; j < 8; ++j) expected[size_t(j)] = n * double(strataProbability(cdf.data(), j));
+    chi2::Result r = chi2::testCounts(observed, expected);
+    EXPECT_TRUE(r.passed) << r.message;
+}
+
+TEST(HemiFrame, OrthonormalAndInverse) {
+    std::mt19937_64 rng(5);
+    for (int i = 0; i < 1000; ++i) {
+        glm::vec3 n = gaussianDirection(rng);
+        if (i == 0) n = glm::vec3(0, 0, -1);
+        if (i == 1) n = glm::vec3(0, 0, 1);
+        HemiFrame f = HemiFrame::fromZ(n);
+        EXPECT_NEAR(glm::dot(f.s, f.t), 0.f, 1e-5f);
+        EXPECT_NEAR(glm::dot(f.s, f.n), 0.f, 1e-5f);
+        EXPECT_NEAR(glm::dot(f.t, f.n), 0.f, 1e-5f);
+        EXPECT_NEAR(glm::length(f.s), 1.f, 1e-5f);
+        glm::vec3 v = gaussianDirection(rng);
+        glm::vec3 back = f.toWorld(f.toLocal(v));
+        EXPECT_NEAR(glm::length(back - v), 0.f, 1e-5f);
+        EXPECT_NEAR(f.toLocal(n).z, 1.f, 1e-5f);
+    }
+}
+
+}  // namespace
+}  // namespace rlpbrt::guiding
