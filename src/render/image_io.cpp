@@ -13,6 +13,14 @@
 #include <memory>
 
 #include <dlfcn.h>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <mutex>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -140,6 +148,76 @@ const OiioModule& oiio() {
     return module;
 }
 
+// EXR goes through OpenEXR directly (cheap to load); other formats through the OIIO module.
+bool writeExr(const std::string& file, const Image& img, const std::vector<float>& rgb,
+              const std::vector<std::pair<std::string, std::string>>& metadata,
+              std::string* error) {
+    try {
+        Imf::Header header(img.width, img.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+        for (const auto& kv : metadata)
+            header.insert(kv.first, Imf::StringAttribute(kv.second));
+        Imf::OutputFile out(file.c_str(), header);
+        Imf::FrameBuffer fb;
+        const size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
+        char* base = reinterpret_cast<char*>(const_cast<float*>(rgb.data()));
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        out.setFrameBuffer(fb);
+        out.writePixels(img.height);
+    } catch (const std::exception& e) {
+        return fail(error, "cannot write \"" + file + "\": " + e.what());
+    }
+    return true;
+}
+
+// Reads an EXR's data window as RGB (a single Y channel is replicated).
+bool readExr(const std::string& path, Image* out, std::string* error, ImageFileInfo* info) {
+    try {
+        Imf::InputFile in(path.c_str());
+        const Imath::Box2i dw = in.header().dataWindow();
+        const long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
+        if (w <= 0 || h <= 0 || double(w) * double(h) > 1e9)
+            return fail(error, "image \"" + path + "\" has an unsupported size");
+        const Imf::ChannelList& ch = in.header().channels();
+        bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
+        bool grey = !rgb && ch.findChannel("Y");
+        if (!rgb && !grey)
+            return fail(error, "image \"" + path + "\" has neither R, G, B nor Y channels");
+        Image img;
+        img.width = int(w);
+        img.height = int(h);
+        img.channels = 3;
+        img.pixels.assign(size_t(w) * size_t(h) * 3, 0.f);
+        const size_t xs = 3 * sizeof(float), ys = xs * size_t(w);
+        // OpenEXR addresses the buffer with data-window coordinates.
+        char* base = reinterpret_cast<char*>(img.pixels.data()) -
+                     (long(dw.min.x) * long(xs) + long(dw.min.y) * long(ys));
+        Imf::FrameBuffer fb;
+        const char* names[3] = {"R", "G", "B"};
+        for (int c = 0; c < (grey ? 1 : 3); ++c)
+            fb.insert(grey ? "Y" : names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+        in.setFrameBuffer(fb);
+        in.readPixels(dw.min.y, dw.max.y);
+        if (grey)
+            for (size_t i = 0; i < img.pixels.size(); i += 3)
+                img.pixels[i + 1] = img.pixels[i + 2] = img.pixels[i];
+        if (info) {
+            info->format = "openexr";
+            int n = 0;
+            for (auto it = ch.begin(); it != ch.end(); ++it) ++n;
+            info->fileChannels = n;
+            info->eightBit = false;
+        }
+        *out = std::move(img);
+    } catch (const std::exception& e) {
+        return fail(error, "cannot read image \"" + path + "\": " + e.what());
+    }
+    return true;
+}
+
 // Writes through OIIO: `data` holds w * h * 3 bytes (isByte) or floats.
 bool writeOiio(const std::string& file, int w, int h, bool isByte, const void* data,
                const std::vector<std::pair<std::string, std::string>>& metadata,
@@ -176,6 +254,7 @@ bool pbrtDefaultGamma(const std::string& path) {
 }
 
 bool readImage(const std::string& path, Image* out, std::string* error, ImageFileInfo* info) {
+    if (lowerExtension(path) == ".exr") return readExr(path, out, error, info);
     const OiioModule& m = oiio();
     if (!m.read) return fail(error, m.error);
     float* raw = nullptr;
@@ -250,10 +329,9 @@ bool writeImage(const std::string& path, const Image& img,
         }
         ok = writeOiio(tmp.name(), img.width, img.height, true, bytes.data(), metadata, error);
     } else {
-        ok = writeOiio(tmp.name(), img.width, img.height, false, clean.data(),
-                       ext == ".exr" ? metadata
-                                     : std::vector<std::pair<std::string, std::string>>(),
-                       error);
+        ok = ext == ".exr" ? writeExr(tmp.name(), img, clean, metadata, error)
+                           : writeOiio(tmp.name(), img.width, img.height, false, clean.data(),
+                                       {}, error);
     }
     if (!ok) return false;
 
