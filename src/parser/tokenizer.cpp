@@ -1,7 +1,11 @@
 #include "parser/tokenizer.h"
 
 #include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace rlpbrt {
 
@@ -12,9 +16,25 @@ bool Token::isNumberLike() const {
 }
 
 Tokenizer::Tokenizer(std::string contents, const std::string* file, Diagnostics& diag)
-    : contents_(std::move(contents)), file_(file), diag_(diag) {
-    // Skip a UTF-8 byte order mark; columns still count from the first real character.
-    if (contents_.compare(0, 3, "\xEF\xBB\xBF") == 0) pos_ = lineStart_ = 3;
+    : owned_(std::move(contents)), file_(file), diag_(diag) {
+    data_ = owned_.data();
+    size_ = owned_.size();
+    skipBom();
+}
+
+Tokenizer::Tokenizer(void* map, std::size_t size, const std::string* file, Diagnostics& diag)
+    : data_(static_cast<const char*>(map)), size_(size), map_(map), mapSize_(size), file_(file),
+      diag_(diag) {
+    skipBom();
+}
+
+Tokenizer::~Tokenizer() {
+    if (map_) munmap(map_, mapSize_);
+}
+
+// Skips a UTF-8 byte order mark; columns still count from the first real character.
+void Tokenizer::skipBom() {
+    if (size_ >= 3 && std::memcmp(data_, "\xEF\xBB\xBF", 3) == 0) pos_ = lineStart_ = 3;
 }
 
 std::unique_ptr<Tokenizer> Tokenizer::fromFile(const std::string& path, Diagnostics& diag,
@@ -27,6 +47,32 @@ std::unique_ptr<Tokenizer> Tokenizer::fromFile(const std::string& path, Diagnost
     if (S_ISDIR(st.st_mode)) {
         diag.error(includedFrom, "\"" + path + "\" is a directory, not a scene file");
         return nullptr;
+    }
+    // Regular files are mapped (no copy, no zero-filled buffer); others are read.
+    if (S_ISREG(st.st_mode) && st.st_size > 0) {
+        int fd = ::open(path.c_str(), O_RDONLY);
+        if (fd >= 0) {
+            void* m = mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+            ::close(fd);
+            if (m != MAP_FAILED) {
+                madvise(m, std::size_t(st.st_size), MADV_SEQUENTIAL);
+                return std::unique_ptr<Tokenizer>(
+                    new Tokenizer(m, std::size_t(st.st_size), diag.intern(path), diag));
+            }
+        }
+    }
+    // Regular files are mapped (no copy, no zero-filled buffer); others are read.
+    if (S_ISREG(st.st_mode) && st.st_size > 0) {
+        int fd = ::open(path.c_str(), O_RDONLY);
+        if (fd >= 0) {
+            void* m = mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+            ::close(fd);
+            if (m != MAP_FAILED) {
+                madvise(m, std::size_t(st.st_size), MADV_SEQUENTIAL);
+                return std::unique_ptr<Tokenizer>(
+                    new Tokenizer(m, std::size_t(st.st_size), diag.intern(path), diag));
+            }
+        }
     }
     FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) {
@@ -50,8 +96,8 @@ std::unique_ptr<Tokenizer> Tokenizer::fromString(std::string text, const std::st
 }
 
 bool Tokenizer::next(Token* tok) {
-    const std::size_t n = contents_.size();
-    const char* s = contents_.data();
+    const std::size_t n = size_;
+    const char* s = data_;
     while (pos_ < n) {
         char c = s[pos_];
         if (c == '\n') {

@@ -35,9 +35,22 @@ public:
 
 private:
     Tokenizer(std::string contents, const std::string* file, Diagnostics& diag);
+    Tokenizer(void* map, std::size_t size, const std::string* file, Diagnostics& diag);
+    void skipBom();
+
+public:
+    ~Tokenizer();
+    Tokenizer(const Tokenizer&) = delete;
+    Tokenizer& operator=(const Tokenizer&) = delete;
+
+private:
     FileLoc here(std::size_t pos) const { return FileLoc{file_, line_, int(pos - lineStart_) + 1}; }
 
-    std::string contents_;
+    std::string owned_;           // text held in memory (fromString, or a file that was read)
+    const char* data_ = nullptr;  // the text: owned_ or a read-only mapping of the file
+    std::size_t size_ = 0;
+    void* map_ = nullptr;         // file mapping, unmapped by the destructor
+    std::size_t mapSize_ = 0;
     const std::string* file_;
     Diagnostics& diag_;
     std::size_t pos_ = 0, lineStart_ = 0;
