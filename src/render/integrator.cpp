@@ -21,20 +21,86 @@ Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
     return out;
 }
 
-PathIntegrator::PathIntegrator(const Scene& scene)
+PathIntegrator::PathIntegrator(const Scene& scene, const GuideSettings& guide)
     : scene_(scene),
       lights_(createLightSampler(scene.integrator.lightSampleStrategy, scene.lights,
                                  scene.boundsMin(), scene.boundsMax(), nullptr)),
-      maxDepth_(scene.integrator.maxDepth), rrThreshold_(scene.integrator.rrThreshold) {}
+      guide_(guide), maxDepth_(scene.integrator.maxDepth),
+      rrThreshold_(scene.integrator.rrThreshold) {
+    guide_.mix = clamp(guide_.mix, 0.f, 1.f);
+    if (guide_.mix == 0.f && !guide_.learn) guide_.field = nullptr;
+}
 
 namespace {
 // Offsets a ray origin to the side of the surface that direction w leaves on.
 Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w) {
     return offsetRayOrigin(si.p, glm::dot(w, si.ng) > 0.f ? si.ng : -si.ng);
 }
+
+// A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide).
+bool guidable(const BSDF& bsdf) {
+    return bsdf.numComponents(BxDFFlags::Specular) == 0 && bsdf.numComponents() > 0;
+}
+
+// The pending training record of the last guided vertex: its region and direction, and the
+// target collected so far through delta vertices (weight = product of their f cos / pdf).
+struct PendingRecord {
+    int region = -1;
+    Vec3 w{0.f};
+    float target = 0.f;
+    float weight = 1.f;
+    bool active() const { return region >= 0; }
+};
 }  // namespace
 
-Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf,
+float PathIntegrator::directionPdf(const BSDF& bsdf, int region, const Vec3& wo,
+                                   const Vec3& wi) const {
+    float pb = bsdf.pdf(wo, wi);
+    if (region < 0) return pb;
+    return guide_.mix * guide_.field->pdf(region, wi) + (1.f - guide_.mix) * pb;
+}
+
+PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
+                                                                const BSDF& bsdf, int region,
+                                                                Sampler& sampler) const {
+    DirectionSample ds;
+    float uc = sampler.get1D();
+    Vec2 u = sampler.get2D();
+    if (region < 0) {
+        BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
+        if (!bs.valid()) return ds;
+        ds.f = bs.f;
+        ds.wi = bs.wi;
+        ds.pdf = bs.pdf;
+        ds.specular = bs.isSpecular();
+        ds.transmission = bs.isTransmission();
+        return ds;
+    }
+    // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
+    const float mix = guide_.mix;
+    float pGuide = 0.f, pBsdf = 0.f;
+    if (uc < mix) {
+        float uStratum = std::min(uc / mix, OneMinusEpsilon);
+        ds.wi = guide_.field->sample(region, u, uStratum, &pGuide);
+        if (!(pGuide > 0.f)) return DirectionSample();
+        ds.f = bsdf.f(si.wo, ds.wi);
+        pBsdf = bsdf.pdf(si.wo, ds.wi);
+    } else {
+        float ub = std::min((uc - mix) / (1.f - mix), OneMinusEpsilon);
+        BSDFSample bs = bsdf.sampleF(si.wo, ub, u);
+        if (!bs.valid()) return DirectionSample();
+        ds.wi = bs.wi;
+        ds.f = bs.f;
+        pBsdf = bs.pdf;
+        pGuide = guide_.field->pdf(region, ds.wi);
+    }
+    ds.pdf = mix * pGuide + (1.f - mix) * pBsdf;
+    ds.transmission = glm::dot(ds.wi, si.ng) * glm::dot(si.wo, si.ng) < 0.f;
+    if (!(ds.pdf > 0.f) || !std::isfinite(ds.pdf)) return DirectionSample();
+    return ds;
+}
+
+Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                                      Sampler& sampler, PathStats& stats) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
@@ -53,18 +119,37 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     if (scene_.occluded(o, ls.wi, tMax)) return Spectrum(0.f);
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1, bsdf.pdf(si.wo, ls.wi));
+    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, si.wo, ls.wi));
     return f * ls.L * (w / lightPdf);
 }
 
-Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& stats) const {
+float PathIntegrator::scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                                      const Vec3& woY) const {
+    Vec3 n = glm::dot(si.ns, woY) >= 0.f ? si.ns : -si.ns;
+    return guide_.field->scatteredEstimate(region, [&](const glm::vec3& wj) {
+        float c = glm::dot(wj, n);
+        return c > 0.f ? luminance(bsdf.f(woY, wj)) * c : 0.f;
+    });
+}
+
+Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& stats,
+                            int slot) const {
     Spectrum L(0.f), beta(1.f);
     Ray ray = cameraRay;
     bool specularBounce = false;
-    float bsdfPdf = 0.f, etaScale = 1.f;
+    float dirPdf = 0.f, etaScale = 1.f;
     LightSampleContext prev;
     int passThroughs = 0;
     BSDF bsdf;
+    guiding::GuidingField* field = guide_.field;
+    const bool learn = field && guide_.learn;
+    PendingRecord pending;
+    auto flush = [&](float addTarget) {
+        if (!pending.active()) return;
+        pending.target += pending.weight * addTarget;
+        field->record(slot, pending.region, pending.w, pending.target);
+        pending = PendingRecord();
+    };
     for (int bounces = 0;; ++bounces) {
         SurfaceInteraction si;
         ++stats.rays;
@@ -72,62 +157,96 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // Emission reached by the previous scattering (or seen by the camera), weighted by
         // MIS against next-event estimation.
         if (!found) {
+            float envLum = 0.f;
             for (int idx : scene_.infiniteLights) {
                 const Light& light = *scene_.lights[size_t(idx)];
                 Spectrum Le = light.Le(ray.d);
                 if (isBlack(Le)) continue;
+                envLum += luminance(Le);
                 if (bounces == 0 || specularBounce) {
                     L += beta * Le;
                 } else {
                     float lightPdf = lights_->pmf(prev.p, idx) *
                                      light.pdfLi(prev, ray.d, Vec3(0.f), Vec3(0.f));
-                    L += beta * Le * powerHeuristic(1, bsdfPdf, 1, lightPdf);
+                    L += beta * Le * powerHeuristic(1, dirPdf, 1, lightPdf);
                 }
             }
+            if (learn) flush(envLum);
             break;
         }
+        float emitted = 0.f;
         if (si.light >= 0) {
             const Light& light = *scene_.lights[size_t(si.light)];
             Spectrum Le = light.L(si.p, si.ng, si.uv, si.wo);
             if (!isBlack(Le)) {
+                emitted = luminance(Le);
                 if (bounces == 0 || specularBounce) {
                     L += beta * Le;
                 } else {
                     float lightPdf = lights_->pmf(prev.p, si.light) *
                                      light.pdfLi(prev, ray.d, si.p, si.ng);
-                    L += beta * Le * powerHeuristic(1, bsdfPdf, 1, lightPdf);
+                    L += beta * Le * powerHeuristic(1, dirPdf, 1, lightPdf);
                 }
             }
         }
-        if (bounces >= maxDepth_) break;
         // Medium boundaries without a surface: continue the ray unchanged.
         if (si.material < 0) {
-            if (++passThroughs > 256) break;
+            if (bounces >= maxDepth_ || ++passThroughs > 256) break;
+            if (pending.active()) pending.target += pending.weight * emitted;
             ray.o = spawnOrigin(si, ray.d);
             --bounces;
             continue;
         }
-        ++stats.vertices;
+        if (bounces >= maxDepth_ && !pending.active()) break;
         bsdf.clear();
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
+        const bool canGuide = field && guidable(bsdf);
+        int region = -1;
+        if (canGuide) {
+            Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
+            region = field->lookup(si.p, nFacing);
+        }
+        // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
+        // y, carried unchanged through delta vertices.
+        if (learn && pending.active()) {
+            if (region >= 0)
+                flush(emitted + scatteredTarget(si, bsdf, region, si.wo));
+            else if (canGuide || bsdf.numComponents() == 0)
+                pending = PendingRecord();  // no data at y: nothing to learn from
+            else
+                pending.target += pending.weight * emitted;  // delta y: continue the chain
+        }
+        if (bounces >= maxDepth_) break;
+        ++stats.vertices;
+        const int sampleRegion = guide_.mix > 0.f ? region : -1;
         // Next-event estimation at non-specular vertices.
         if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
-            L += beta * sampleLight(si, bsdf, sampler, stats);
+            L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats);
         // Sample the next direction (the guiding seam).
-        float uc = sampler.get1D();
-        Vec2 u = sampler.get2D();
-        BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
-        if (!bs.valid() || isBlack(bs.f)) break;
-        beta *= bs.f * std::abs(glm::dot(bs.wi, si.ns)) / bs.pdf;
-        bsdfPdf = bs.pdf;
-        specularBounce = bs.isSpecular();
-        if (bs.isSpecular() && bs.isTransmission()) {
+        DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, sampler);
+        if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
+        Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
+        beta *= weight;
+        dirPdf = ds.pdf;
+        specularBounce = ds.specular;
+        if (learn) {
+            if (region >= 0 && !ds.transmission) {
+                pending = PendingRecord();
+                pending.region = region;
+                pending.w = ds.wi;
+            } else if (pending.active() && region < 0 && !canGuide) {
+                pending.weight *= luminance(weight);  // through a delta vertex
+            } else {
+                pending = PendingRecord();
+            }
+        }
+        if (ds.specular && ds.transmission) {
             float eta = bsdf.eta();
             etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
         }
         prev = LightSampleContext{si.p, si.ng};
-        ray.o = spawnOrigin(si, bs.wi);
-        ray.d = bs.wi;
+        ray.o = spawnOrigin(si, ds.wi);
+        ray.d = ds.wi;
         ray.tMax = Infinity;
         if (!isFinite(beta)) break;
         // Russian roulette (pbrt-v3: after bounce 3, on beta scaled by the refraction eta).

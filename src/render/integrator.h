@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "guiding/guiding.h"
 #include "render/light_sampler.h"
 #include "render/ray.h"
 #include "render/scene.h"
@@ -28,18 +29,43 @@ struct PathStats {
     }
 };
 
+// How the integrator uses a guiding field (none when field is null).
+struct GuideSettings {
+    guiding::GuidingField* field = nullptr;
+    // Probability of sampling a direction from the guide at a vertex that has guiding data
+    // (one-sample MIS mixture with BSDF sampling): 0 = BSDF only, 1 = the paper's pure policy.
+    float mix = 0.5f;
+    bool learn = true;  // record Eq. 1 targets during rendering
+};
+
 class PathIntegrator {
 public:
-    explicit PathIntegrator(const Scene& scene);
-    // Radiance arriving along a camera ray; consumes dimensions of `sampler`.
-    Spectrum Li(const Ray& ray, Sampler& sampler, PathStats& stats) const;
+    PathIntegrator(const Scene& scene, const GuideSettings& guide = {});
+    // Radiance arriving along a camera ray; consumes dimensions of `sampler`. `slot` is the
+    // work item (film tile) index, used to record guiding targets deterministically.
+    Spectrum Li(const Ray& ray, Sampler& sampler, PathStats& stats, int slot = 0) const;
 
 private:
-    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, Sampler& sampler,
-                         PathStats& stats) const;
+    // The direction-sampling seam: a BSDF sample, or a guided one mixed with the BSDF.
+    struct DirectionSample {
+        Spectrum f{0.f};
+        Vec3 wi{0.f};
+        float pdf = 0.f;       // of the whole strategy (mixture pdf when guided)
+        bool specular = false;
+        bool transmission = false;
+    };
+    DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                                    Sampler& sampler) const;
+    float directionPdf(const BSDF& bsdf, int region, const Vec3& wo, const Vec3& wi) const;
+    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                         Sampler& sampler, PathStats& stats) const;
+    // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance).
+    float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                          const Vec3& woY) const;
 
     const Scene& scene_;
     std::unique_ptr<LightSampler> lights_;
+    GuideSettings guide_;
     int maxDepth_;
     float rrThreshold_;
 };

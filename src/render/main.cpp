@@ -76,7 +76,12 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 4096));
     app.add_option("--seed", seed, "random seed");
     app.add_flag("--quiet,-q", quiet, "no progress or summary output");
-    app.add_option("--guide", guide, "guiding backend")->check(CLI::IsMember({"none"}));
+    std::vector<std::string> guideParams;
+    app.add_option("--guide", guide, "guiding backend: none or hemi")
+        ->check(CLI::IsMember({"none", "hemi"}));
+    app.add_option("--guide-param", guideParams,
+                   "guiding parameter key=value (repeatable): mix, alpha, strata (WxH), "
+                   "points, normal-angle, init, epsilon, knn");
     app.add_option("--stats", statsFile, "write run statistics as JSON");
     CLI11_PARSE(app, argc, argv);
 
@@ -111,6 +116,52 @@ int main(int argc, char** argv) {
         return 0;
     }
 
+    // The guiding field (none: plain path tracing).
+    guiding::GuideConfig gc;
+    gc.backend = guide;
+    float mix = 0.5f;
+    for (const std::string& kv : guideParams) {
+        auto eq = kv.find('=');
+        if (eq == std::string::npos || eq == 0) {
+            std::fprintf(stderr, "error: --guide-param expects key=value, got \"%s\"\n", kv.c_str());
+            return 1;
+        }
+        gc.params[kv.substr(0, eq)] = kv.substr(eq + 1);
+    }
+    if (gc.params.count("mix")) {
+        char* end = nullptr;
+        const std::string& v = gc.params["mix"];
+        mix = std::strtof(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !(mix >= 0.f && mix <= 1.f)) {
+            std::fprintf(stderr, "error: --guide-param mix must be a number in [0, 1], got \"%s\"\n",
+                         v.c_str());
+            return 1;
+        }
+    }
+    std::unique_ptr<guiding::GuidingField> field;
+    if (guide != "none") {
+        guiding::SceneInfo info;
+        info.boundsMin = scene->boundsMin();
+        info.boundsMax = scene->boundsMax();
+        info.totalArea = scene->totalSurfaceArea();
+        const Scene* sc = scene.get();
+        info.samplePoint = [sc](const glm::vec3& u, glm::vec3* p, glm::vec3* n) {
+            return sc->sampleSurface(u, p, n);
+        };
+        std::string gerr;
+        double tg = seconds();
+        field = guiding::createGuidingField(gc, info, &gerr);
+        if (!field) {
+            std::fprintf(stderr, "error: --guide=%s: %s\n", guide.c_str(), gerr.c_str());
+            return 1;
+        }
+        if (!quiet)
+            std::fprintf(stderr, "guide: %s (%.2f s to build)\n", field->describe().c_str(),
+                         seconds() - tg);
+    } else if (!guideParams.empty()) {
+        std::fprintf(stderr, "warning: --guide-param is ignored with --guide=none\n");
+    }
+
     if (outFile.empty()) outFile = defaultOutput(*scene);
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
@@ -119,6 +170,8 @@ int main(int argc, char** argv) {
     ro.timeBudget = timeBudget;
     ro.progress = !quiet && isatty(STDERR_FILENO);
     ro.cancel = &gCancel;
+    ro.guide.field = field.get();
+    ro.guide.mix = mix;
     RenderResult r = render(*scene, ro);
 
     std::vector<std::pair<std::string, std::string>> meta = {
@@ -149,7 +202,13 @@ int main(int argc, char** argv) {
         j["zero_contribution_fraction"] = s.paths ? double(s.zeroRadiancePaths) / s.paths : 0.0;
         j["mean_path_length"] = s.paths ? double(s.vertices) / s.paths : 0.0;
         j["guide"] = guide;
-        j["guide_bytes"] = 0;
+        j["guide_bytes"] = field ? field->bytes() : 0;
+        if (field) {
+            guiding::GuidingStats gs = field->stats();
+            j["guide_records"] = gs.records;
+            j["guide_rejected_targets"] = gs.rejectedTargets;
+            j["guide_mix"] = mix;
+        }
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;
         std::ofstream f(statsFile);

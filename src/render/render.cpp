@@ -45,7 +45,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(nThreads));
     tbb::task_arena arena(nThreads);
 
-    PathIntegrator integrator(scene);
+    PathIntegrator integrator(scene, options.guide);
+    guiding::GuidingField* field = options.guide.field;
     const int totalSpp = scene.sampler->samplesPerPixel();
     const bool timed = options.timeBudget > 0.0;
     // Samples per pass: one while the budget is open-ended; otherwise a few passes so that
@@ -67,6 +68,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         int first = result.spp;
         int count = timed ? sppPerPass : std::min(sppPerPass, totalSpp - first);
         if (!timed && count <= 0) break;
+        if (field) field->beginPass(int(tiles.size()));
         arena.execute([&] {
             tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
                 Sampler& sampler = *samplers.local();
@@ -81,7 +83,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                             Vec2 uLens = sampler.get2D();
                             CameraRay cr = scene.camera->generateRay(pFilm, uLens);
                             Spectrum L(0.f);
-                            if (cr.weight > 0.f) L = integrator.Li(cr.ray, sampler, st);
+                            if (cr.weight > 0.f) L = integrator.Li(cr.ray, sampler, st, int(ti));
                             ++st.paths;
                             if (!isFinite(L)) {
                                 ++st.nonFinite;
@@ -93,6 +95,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                         }
             });
         });
+        // The guide learns between passes: every pass samples from a frozen policy.
+        if (field) field->endPass();
         film.mergeTiles(tileFilms);
         for (auto& t : tileFilms) t->clear();
         result.spp += count;

@@ -17,6 +17,7 @@ struct RenderOptions {
     double timeBudget = 0.0;     // seconds; > 0 renders whole passes until it is spent
     bool progress = false;       // progress bar on stderr
     const std::atomic<bool>* cancel = nullptr;  // set to stop after the current pass
+    GuideSettings guide;         // guiding field (null = plain path tracing) and mixture
     // Called after each pass with the image so far (for curves and checkpoints).
     std::function<void(int spp, double seconds, const Film& film)> onPass;
 };

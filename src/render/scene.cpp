@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 
+#include "render/sampling.h"
 #include "render/spectrum.h"
 #include "render/transform.h"
 
@@ -236,6 +237,102 @@ void Scene::hitDetails(const Primitive& prim, unsigned primID, float u, float v,
             si->shadingTangent = transformVector(w, si->shadingTangent);
     }
     si->wo = -ray.d;
+}
+
+// ------------------------------------------------------------------------------------------
+// Uniform surface sampling (for guiding data placement).
+
+namespace {
+// Area scale of a transform for similarity transforms: |det|^(2/3).
+float areaScale(const Mat4& m) {
+    return std::pow(std::abs(glm::determinant(glm::mat3(m))), 2.f / 3.f);
+}
+float quadricWorldArea(const QuadricShape& q) {
+    return area(q.quadric) * areaScale(q.worldFromObject);
+}
+}  // namespace
+
+void Scene::buildAreaTables() const {
+    groupAreas_.resize(groups_.size());
+    for (size_t g = 0; g < groups_.size(); ++g) {
+        AreaTable& t = groupAreas_[g];
+        std::vector<float> primAreas;
+        t.triangles.resize(groups_[g].prims.size());
+        for (size_t i = 0; i < groups_[g].prims.size(); ++i) {
+            const Primitive& prim = groups_[g].prims[i];
+            double a = 0.0;
+            if (const TriangleMesh* m = prim.shape.mesh.get()) {
+                std::vector<float> tri(m->triangleCount());
+                for (size_t k = 0; k < tri.size(); ++k) {
+                    tri[k] = m->triangleArea(k);
+                    if (!std::isfinite(tri[k])) tri[k] = 0.f;
+                    a += tri[k];
+                }
+                if (!tri.empty()) t.triangles[i] = Distribution1D(tri);
+            } else if (prim.shape.quadric) {
+                a = quadricWorldArea(*prim.shape.quadric);
+            }
+            if (!std::isfinite(a)) a = 0.0;
+            primAreas.push_back(float(a));
+            t.area += a;
+        }
+        if (!primAreas.empty()) t.prims = Distribution1D(primAreas);
+    }
+    std::vector<float> top;
+    top.push_back(float(groupAreas_.empty() ? 0.0 : groupAreas_[0].area));
+    totalArea_ = top[0];
+    for (const Instance& inst : instances_) {
+        double a = groupAreas_[size_t(inst.group)].area * areaScale(inst.worldFromInstance);
+        top.push_back(float(a));
+        totalArea_ += a;
+    }
+    topLevel_ = Distribution1D(top);
+}
+
+bool Scene::sampleGroup(int group, const Vec3& u, Vec3* p, Vec3* n) const {
+    const AreaTable& t = groupAreas_[size_t(group)];
+    if (!(t.area > 0.0)) return false;
+    float ur;
+    int i = t.prims.sampleDiscrete(u.x, nullptr, &ur);
+    const Primitive& prim = groups_[size_t(group)].prims[size_t(i)];
+    if (const TriangleMesh* m = prim.shape.mesh.get()) {
+        float ut;
+        int k = t.triangles[size_t(i)].sampleDiscrete(ur, nullptr, &ut);
+        Vec2 b = sampleUniformTriangle(Vec2(ut, u.y));
+        const Vec3& p0 = m->p[m->indices[3 * size_t(k)]];
+        const Vec3& p1 = m->p[m->indices[3 * size_t(k) + 1]];
+        const Vec3& p2 = m->p[m->indices[3 * size_t(k) + 2]];
+        *p = b.x * p0 + b.y * p1 + (1.f - b.x - b.y) * p2;
+        Vec3 c = glm::cross(p1 - p0, p2 - p0);
+        float len = glm::length(c);
+        if (!(len > 0.f)) return false;
+        *n = c / len;
+        return true;
+    }
+    const QuadricShape& q = *prim.shape.quadric;
+    QuadricSample qs;
+    if (!sampleArea(q.quadric, Vec2(ur, u.y), &qs)) return false;
+    *p = transformPoint(q.worldFromObject, qs.p);
+    *n = glm::normalize(transformNormal(q.objectFromWorld, qs.n));
+    return isFinite(*p) && isFinite(*n);
+}
+
+bool Scene::sampleSurface(const Vec3& u, Vec3* p, Vec3* n) const {
+    std::call_once(areaOnce_, [this] { buildAreaTables(); });
+    if (!(totalArea_ > 0.0)) return false;
+    float ur;
+    int e = topLevel_.sampleDiscrete(u.x, nullptr, &ur);
+    if (e == 0) return sampleGroup(0, Vec3(ur, u.y, u.z), p, n);
+    const Instance& inst = instances_[size_t(e - 1)];
+    if (!sampleGroup(inst.group, Vec3(ur, u.y, u.z), p, n)) return false;
+    *p = transformPoint(inst.worldFromInstance, *p);
+    *n = glm::normalize(transformNormal(inst.instanceFromWorld, *n));
+    return isFinite(*p) && isFinite(*n);
+}
+
+double Scene::totalSurfaceArea() const {
+    std::call_once(areaOnce_, [this] { buildAreaTables(); });
+    return totalArea_;
 }
 
 // ------------------------------------------------------------------------------------------

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "parser/diagnostics.h"
 #include "render/camera.h"
+#include "render/distribution.h"
 #include "render/film.h"
 #include "render/interaction.h"
 #include "render/lights.h"
@@ -77,6 +79,12 @@ public:
     // True if anything blocks the segment from o along d (unit) up to distance tMax.
     bool occluded(const Vec3& o, const Vec3& d, float tMax) const;
 
+    // A point drawn (approximately) uniformly over all surface area, with its unit geometric
+    // normal; false if the scene has no surface. Instances count with their own transforms
+    // (areas exact for similarity transforms). For placing guiding data, not for estimators.
+    bool sampleSurface(const Vec3& u, Vec3* p, Vec3* n) const;
+    double totalSurfaceArea() const;
+
     Vec3 boundsMin() const { return bMin_; }
     Vec3 boundsMax() const { return bMax_; }
 
@@ -101,8 +109,19 @@ private:
     RTCSceneTy* top_ = nullptr;
     std::vector<PrimitiveGroup> groups_;  // 0 = world; others = objects
     std::vector<Instance> instances_;     // indexed by the instance geomID in the top scene
-    std::vector<int> topKind_;            // per top-level geomID: -1 = world prim, else instance
-    std::vector<int> topIndex_;           // per top-level geomID: prim index or instance index
+    // Surface sampling (built on first use): areas of world primitives and instances, and
+    // per group the areas of its primitives' triangles/quadrics.
+    struct AreaTable {
+        Distribution1D prims;                     // over the group's primitives
+        std::vector<Distribution1D> triangles;    // per mesh primitive, over its triangles
+        double area = 0.0;
+    };
+    void buildAreaTables() const;
+    bool sampleGroup(int group, const Vec3& u, Vec3* p, Vec3* n) const;
+    mutable std::once_flag areaOnce_;
+    mutable std::vector<AreaTable> groupAreas_;
+    mutable Distribution1D topLevel_;  // world group (entry 0) + one entry per instance
+    mutable double totalArea_ = 0.0;
     Vec3 bMin_{0.f}, bMax_{0.f};
 };
 
