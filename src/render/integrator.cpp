@@ -1,5 +1,6 @@
 #include "render/integrator.h"
 
+#include <cstdlib>
 #include <cstring>
 
 #include "render/sampling.h"
@@ -29,6 +30,36 @@ PathIntegrator::PathIntegrator(const Scene& scene, const GuideSettings& guide)
       rrThreshold_(scene.integrator.rrThreshold) {
     guide_.mix = clamp(guide_.mix, 0.f, 1.f);
     if (guide_.mix == 0.f && !guide_.learn) guide_.field = nullptr;
+}
+
+bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
+                  std::unique_ptr<guiding::GuidingField>* field, GuideSettings* settings,
+                  std::string* error) {
+    *settings = GuideSettings();
+    field->reset();
+    auto it = config.params.find("mix");
+    if (it != config.params.end()) {
+        char* end = nullptr;
+        float mix = std::strtof(it->second.c_str(), &end);
+        if (end == it->second.c_str() || *end != '\0' || !(mix >= 0.f && mix <= 1.f)) {
+            *error = "mix must be a number in [0, 1], got \"" + it->second + "\"";
+            return false;
+        }
+        settings->mix = mix;
+    }
+    if (config.backend == "none") return true;
+    guiding::SceneInfo info;
+    info.boundsMin = scene.boundsMin();
+    info.boundsMax = scene.boundsMax();
+    info.totalArea = scene.totalSurfaceArea();
+    const Scene* sc = &scene;
+    info.samplePoint = [sc](const glm::vec3& u, glm::vec3* p, glm::vec3* n) {
+        return sc->sampleSurface(u, p, n);
+    };
+    *field = guiding::createGuidingField(config, info, error);
+    if (!*field) return false;
+    settings->field = field->get();
+    return true;
 }
 
 namespace {
@@ -126,9 +157,22 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
 float PathIntegrator::scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                                       const Vec3& woY) const {
     Vec3 n = glm::dot(si.ns, woY) >= 0.f ? si.ns : -si.ns;
-    return guide_.field->scatteredEstimate(region, [&](const glm::vec3& wj) {
-        float c = glm::dot(wj, n);
-        return c > 0.f ? luminance(bsdf.f(woY, wj)) * c : 0.f;
+    // Lambertian y: the sum is rho/pi times the learned irradiance (no BSDF evaluations).
+    Spectrum albedo(0.f);
+    bool lambertian = true;
+    for (int i = 0; i < bsdf.numComponents() && lambertian; ++i) {
+        if (const auto* l = bsdf.component(i).get<LambertianReflection>()) albedo += l->r;
+        else lambertian = false;
+    }
+    if (lambertian) return luminance(albedo) * InvPi * guide_.field->irradianceEstimate(region, n);
+    struct Ctx {
+        const BSDF& bsdf;
+        Vec3 wo, n;
+    } ctx{bsdf, woY, n};
+    const Ctx* c = &ctx;  // one captured pointer: no allocation in std::function
+    return guide_.field->scatteredEstimate(region, [c](const glm::vec3& wj) {
+        float cosj = glm::dot(wj, c->n);
+        return cosj > 0.f ? luminance(c->bsdf.f(c->wo, wj)) * cosj : 0.f;
     });
 }
 

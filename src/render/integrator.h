@@ -70,6 +70,13 @@ private:
     float rrThreshold_;
 };
 
+// Builds the guiding field of --guide/--guide-param for a scene (null field for "none") and
+// the integrator's guide settings ("mix" is read here; the rest goes to the backend).
+// False with a message in *error for bad configurations.
+bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
+                  std::unique_ptr<guiding::GuidingField>* field, GuideSettings* settings,
+                  std::string* error);
+
 // Moves p off a surface with unit normal n (oriented towards the side the ray leaves on),
 // by a few float ULPs: robust at any scene scale (Wachter and Binder 2019).
 Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n);

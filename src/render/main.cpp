@@ -119,7 +119,6 @@ int main(int argc, char** argv) {
     // The guiding field (none: plain path tracing).
     guiding::GuideConfig gc;
     gc.backend = guide;
-    float mix = 0.5f;
     for (const std::string& kv : guideParams) {
         auto eq = kv.find('=');
         if (eq == std::string::npos || eq == 0) {
@@ -128,39 +127,22 @@ int main(int argc, char** argv) {
         }
         gc.params[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
-    if (gc.params.count("mix")) {
-        char* end = nullptr;
-        const std::string& v = gc.params["mix"];
-        mix = std::strtof(v.c_str(), &end);
-        if (end == v.c_str() || *end != '\0' || !(mix >= 0.f && mix <= 1.f)) {
-            std::fprintf(stderr, "error: --guide-param mix must be a number in [0, 1], got \"%s\"\n",
-                         v.c_str());
-            return 1;
-        }
-    }
+    if (guide == "none" && !guideParams.empty())
+        std::fprintf(stderr, "warning: --guide-param is ignored with --guide=none\n");
     std::unique_ptr<guiding::GuidingField> field;
-    if (guide != "none") {
-        guiding::SceneInfo info;
-        info.boundsMin = scene->boundsMin();
-        info.boundsMax = scene->boundsMax();
-        info.totalArea = scene->totalSurfaceArea();
-        const Scene* sc = scene.get();
-        info.samplePoint = [sc](const glm::vec3& u, glm::vec3* p, glm::vec3* n) {
-            return sc->sampleSurface(u, p, n);
-        };
+    GuideSettings guideSettings;
+    {
         std::string gerr;
         double tg = seconds();
-        field = guiding::createGuidingField(gc, info, &gerr);
-        if (!field) {
+        if (!setupGuiding(*scene, gc, &field, &guideSettings, &gerr)) {
             std::fprintf(stderr, "error: --guide=%s: %s\n", guide.c_str(), gerr.c_str());
             return 1;
         }
-        if (!quiet)
+        if (field && !quiet)
             std::fprintf(stderr, "guide: %s (%.2f s to build)\n", field->describe().c_str(),
                          seconds() - tg);
-    } else if (!guideParams.empty()) {
-        std::fprintf(stderr, "warning: --guide-param is ignored with --guide=none\n");
     }
+    const float mix = guideSettings.mix;
 
     if (outFile.empty()) outFile = defaultOutput(*scene);
     std::signal(SIGINT, onSignal);
@@ -170,8 +152,7 @@ int main(int argc, char** argv) {
     ro.timeBudget = timeBudget;
     ro.progress = !quiet && isatty(STDERR_FILENO);
     ro.cancel = &gCancel;
-    ro.guide.field = field.get();
-    ro.guide.mix = mix;
+    ro.guide = guideSettings;
     RenderResult r = render(*scene, ro);
 
     std::vector<std::pair<std::string, std::string>> meta = {

@@ -53,15 +53,20 @@ const char* kSurfaceScenes[] = {
     "conference-room__conference_room",
 };
 
-class ReferenceTest : public ::testing::TestWithParam<const char*> {};
+// Every backend must pass the same test: guiding changes the noise, never the expectation.
+const char* kGuides[] = {"none", "hemi"};
+
+class ReferenceTest
+    : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
 
 TEST_P(ReferenceTest, MatchesPbrtV3At64spp) {
     RLPBRT_REQUIRE_SHARED();
+    const std::string id = std::get<0>(GetParam());
     std::vector<ManifestRow> rows = readManifest();
     const ManifestRow* row = nullptr;
     for (const auto& r : rows)
-        if (r.id == GetParam()) row = &r;
-    ASSERT_NE(row, nullptr) << "no manifest row " << GetParam();
+        if (r.id == id) row = &r;
+    ASSERT_NE(row, nullptr) << "no manifest row " << id;
     ASSERT_FALSE(row->media);
 
     Diagnostics diag;
@@ -73,7 +78,12 @@ TEST_P(ReferenceTest, MatchesPbrtV3At64spp) {
     bo.seed = 1;
     std::unique_ptr<Scene> scene = buildScene(desc, bo, diag);
     ASSERT_NE(scene, nullptr);
+    guiding::GuideConfig gc;
+    gc.backend = std::get<1>(GetParam());
+    std::unique_ptr<guiding::GuidingField> field;
     RenderOptions ro;
+    std::string gerr;
+    ASSERT_TRUE(setupGuiding(*scene, gc, &field, &ro.guide, &gerr)) << gerr;
     ro.nThreads = 1;  // CTest runs tests in parallel
     RenderResult result = render(*scene, ro);
     EXPECT_EQ(result.spp, 64);
@@ -92,13 +102,16 @@ TEST_P(ReferenceTest, MatchesPbrtV3At64spp) {
     EXPECT_LE(rel, 1.5 * row->relmse64) << "pbrt-v3's own 64 spp relMSE: " << row->relmse64;
     EXPECT_LE(bias, std::max(0.02, 1.5 * row->blockBias64))
         << "pbrt-v3's own 64 spp block bias: " << row->blockBias64;
-    std::printf("%s: relmse %.6g (pbrt-v3 %.6g), block bias %.4g (pbrt-v3 %.4g), %.1f s\n",
-                row->id.c_str(), rel, row->relmse64, bias, row->blockBias64, result.seconds);
+    std::printf("%s [%s]: relmse %.6g (pbrt-v3 %.6g), block bias %.4g (pbrt-v3 %.4g), %.1f s\n",
+                row->id.c_str(), gc.backend.c_str(), rel, row->relmse64, bias, row->blockBias64, result.seconds);
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, ReferenceTest, ::testing::ValuesIn(kSurfaceScenes),
-                         [](const ::testing::TestParamInfo<const char*>& info) {
-                             std::string n = info.param;
+INSTANTIATE_TEST_SUITE_P(Scenes, ReferenceTest,
+                         ::testing::Combine(::testing::ValuesIn(kSurfaceScenes),
+                                            ::testing::ValuesIn(kGuides)),
+                         [](const auto& info) {
+                             std::string n = std::string(std::get<0>(info.param)) + "_" +
+                                             std::get<1>(info.param);
                              for (char& c : n)
                                  if (!isalnum(static_cast<unsigned char>(c))) c = '_';
                              return n;
