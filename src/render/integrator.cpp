@@ -69,8 +69,11 @@ Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w) {
 }
 
 // A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide).
+// (numComponents counts lobes whose flags are all among the requested ones, so "specular
+// lobes" are the lobes not counted without the Specular bit.)
 bool guidable(const BSDF& bsdf) {
-    return bsdf.numComponents(BxDFFlags::Specular) == 0 && bsdf.numComponents() > 0;
+    int all = bsdf.numComponents();
+    return all > 0 && bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) == all;
 }
 
 // The pending training record of the last guided vertex: its region and direction, and the
