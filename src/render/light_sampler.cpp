@@ -53,15 +53,15 @@ SpatialLightSampler::SpatialLightSampler(const std::vector<std::unique_ptr<Light
         int n = maxExtent > 0.f ? int(std::lround(diag[i] / maxExtent * maxVoxels)) : 1;
         n_[i] = std::max(1, n);
     }
-    voxels_ = std::vector<std::atomic<Distribution1D*>>(size_t(n_[0]) * n_[1] * n_[2]);
+    voxels_ = std::vector<std::atomic<float*>>(size_t(n_[0]) * n_[1] * n_[2]);
     for (auto& v : voxels_) v.store(nullptr);
 }
 
 SpatialLightSampler::~SpatialLightSampler() {
-    for (auto& v : voxels_) delete v.load();
+    for (auto& v : voxels_) delete[] v.load();
 }
 
-Distribution1D* SpatialLightSampler::compute(int ix, int iy, int iz) const {
+float* SpatialLightSampler::compute(int ix, int iy, int iz) const {
     Vec3 diag = bMax_ - bMin_;
     Vec3 lo = bMin_ + diag * Vec3(float(ix) / n_[0], float(iy) / n_[1], float(iz) / n_[2]);
     Vec3 hi = bMin_ + diag * Vec3(float(ix + 1) / n_[0], float(iy + 1) / n_[1],
@@ -101,11 +101,25 @@ Distribution1D* SpatialLightSampler::compute(int ix, int iy, int iz) const {
     for (float c : contrib) sum += c;
     float avg = float(sum / std::max<size_t>(1, contrib.size()));
     float minContrib = avg > 0.f ? 0.001f * avg : 1.f;
-    for (float& c : contrib) c = std::max(c, minContrib);
-    return new Distribution1D(contrib);
+    const size_t n = contrib.size();
+    float* block = new float[2 * n + 1];
+    double total = 0;
+    for (float& c : contrib) {
+        c = std::max(c, minContrib);
+        total += c;
+    }
+    double acc = 0;
+    block[0] = 0.f;
+    for (size_t i = 0; i < n; ++i) {
+        acc += contrib[i];
+        block[i + 1] = float(acc / total);
+        block[n + 1 + i] = float(contrib[i] / total);
+    }
+    block[n] = 1.f;
+    return block;
 }
 
-const Distribution1D& SpatialLightSampler::lookup(const Vec3& p) const {
+const float* SpatialLightSampler::lookup(const Vec3& p) const {
     int idx[3];
     for (int i = 0; i < 3; ++i) {
         float extent = bMax_[i] - bMin_[i];
@@ -113,25 +127,32 @@ const Distribution1D& SpatialLightSampler::lookup(const Vec3& p) const {
         idx[i] = clamp(int(t * n_[i]), 0, n_[i] - 1);
     }
     auto& slot = voxels_[(size_t(idx[2]) * n_[1] + idx[1]) * n_[0] + idx[0]];
-    Distribution1D* d = slot.load(std::memory_order_acquire);
-    if (d) return *d;
+    float* d = slot.load(std::memory_order_acquire);
+    if (d) return d;
     // Computed deterministically, so a lost race only wastes work.
-    Distribution1D* mine = compute(idx[0], idx[1], idx[2]);
-    Distribution1D* expected = nullptr;
+    float* mine = compute(idx[0], idx[1], idx[2]);
+    float* expected = nullptr;
     if (slot.compare_exchange_strong(expected, mine, std::memory_order_acq_rel)) {
         computed_.fetch_add(1);
-        return *mine;
+        return mine;
     }
-    delete mine;
-    return *expected;
+    delete[] mine;
+    return expected;
 }
 
 int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf) const {
-    return lookup(p).sampleDiscrete(u, pmf);
+    const float* cdf = lookup(p);
+    const int n = int(lights_.size());
+    // Largest i with cdf[i] <= u, among pieces of non-zero probability.
+    int i = int(std::upper_bound(cdf, cdf + n + 1, u) - cdf) - 1;
+    i = clamp(i, 0, n - 1);
+    while (i > 0 && cdf[n + 1 + i] == 0.f) --i;
+    *pmf = cdf[n + 1 + i];
+    return i;
 }
 
 float SpatialLightSampler::pmf(const Vec3& p, int light) const {
-    return lookup(p).discretePmf(light);
+    return lookup(p)[lights_.size() + 1 + size_t(light)];
 }
 
 std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,

@@ -44,13 +44,15 @@ public:
     int voxelsComputed() const { return computed_.load(); }
 
 private:
-    const Distribution1D& lookup(const Vec3& p) const;
-    Distribution1D* compute(int ix, int iy, int iz) const;
+    // A voxel's distribution in one block: cdf[0..n] then pmf[0..n-1] (one cache-friendly
+    // allocation; looked up at every light sample).
+    const float* lookup(const Vec3& p) const;
+    float* compute(int ix, int iy, int iz) const;
 
     const std::vector<std::unique_ptr<Light>>& lights_;
     Vec3 bMin_, bMax_;
     int n_[3];
-    mutable std::vector<std::atomic<Distribution1D*>> voxels_;
+    mutable std::vector<std::atomic<float*>> voxels_;
     mutable std::atomic<int> computed_{0};
 };
 

@@ -87,33 +87,39 @@ inline uint32_t owenScramble(uint32_t v, uint64_t seed) {
     return reverseBits32(ascendingHash(reverseBits32(v), seed));
 }
 
-// Element i of a pseudo-random permutation of [0, n) chosen by `seed` (0 <= i < n).
-// Small n rank hashed keys (an exactly uniform permutation); larger n cycle-walk a
-// 8-round alternating Feistel network on the next power-of-two domain.
+// Element i of a pseudo-random permutation of [0, n) chosen by seed: Kensler's hash-based
+// permutation ("Correlated Multi-Jittered Sampling", Pixar TM 13-01, 2013), an invertible
+// hash on the next power of two with cycle walking. A few multiplies per call, no tables.
 inline uint32_t permutationElement(uint32_t i, uint32_t n, uint64_t seed) {
     if (n <= 1) return 0;
-    const uint32_t s0 = uint32_t(seed), s1 = uint32_t(seed >> 32);
-    if (n <= 8) {
-        // Rank of key(i) among the n keys (distinct: mixBits32 is a bijection).
-        const uint32_t ki = mixBits32((i * 0x9e3779b9u) ^ s0);
-        uint32_t rank = 0;
-        for (uint32_t j = 0; j < n; ++j) rank += mixBits32((j * 0x9e3779b9u) ^ s0) < ki;
-        return rank;
-    }
-    const int bits = 32 - __builtin_clz(n - 1);
-    const int loBits = bits / 2;
-    const uint32_t loMask = (1u << loBits) - 1;
-    const uint32_t hiMask = uint32_t((uint64_t(1) << (bits - loBits)) - 1);
+    const uint32_t p = uint32_t(seed) ^ uint32_t(seed >> 32);
+    uint32_t w = n - 1;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
     do {
-        uint32_t lo = i & loMask, hi = i >> loBits;
-        for (uint32_t r = 0; r < 8; r += 2) {
-            // Round function: hash of (seed, round, other half).
-            lo ^= mixBits32((hi * 0x9e3779b9u + r) ^ s0) & loMask;
-            hi ^= mixBits32((lo * 0x9e3779b9u + r) ^ s1) & hiMask;
-        }
-        i = lo | (hi << loBits);
+        i ^= p;
+        i *= 0xe170893du;
+        i ^= p >> 16;
+        i ^= (i & w) >> 4;
+        i ^= p >> 8;
+        i *= 0x0929eb3fu;
+        i ^= p >> 23;
+        i ^= (i & w) >> 1;
+        i *= 1u | p >> 27;
+        i *= 0x6935fa69u;
+        i ^= (i & w) >> 11;
+        i *= 0x74dcb303u;
+        i ^= (i & w) >> 2;
+        i *= 0x9e501cc3u;
+        i ^= (i & w) >> 2;
+        i *= 0xc860a3dfu;
+        i &= w;
+        i ^= i >> 5;
     } while (i >= n);
-    return i;
+    return (i + p) % n;
 }
 
 }  // namespace rlpbrt
