@@ -80,7 +80,8 @@ public:
     // batch running mean of the notes section 4, or a fixed alpha) and rebuilds the CDFs.
     virtual void endPass() = 0;
 
-    // Memory of the learned data in bytes (tables, CDFs, points, kd-tree, record buffers).
+    // Memory of the learned data in bytes (tables, CDFs, points, kd-tree; not the per-pass
+    // record buffers).
     virtual size_t bytes() const = 0;
     // One line for logs: points, strata, parameters, memory, counters.
     virtual std::string describe() const = 0;

@@ -30,7 +30,7 @@ bool finite3(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-constexpr size_t kTreeLeafSize = 10;
+constexpr size_t kTreeLeafSize = 16;
 
 }  // namespace
 
@@ -100,13 +100,19 @@ HemiField::~HemiField() = default;
 
 int HemiField::lookup(const glm::vec3& p, const glm::vec3& n) const {
     if (positions_.empty() || !finite3(p)) return -1;
-    constexpr int kMaxK = 64;
-    uint32_t idx[kMaxK];
-    float dist2[kMaxK];
-    const size_t found = tree_->index.knnSearch(&p.x, size_t(params_.knn), idx, dist2);
     const float nLen = glm::length(n);
     if (!(nLen > 0.f)) return -1;
     const float threshold = cosMaxAngle_ * nLen;
+    constexpr int kMaxK = 64;
+    uint32_t idx[kMaxK];
+    float dist2[kMaxK];
+    // Fast path: the nearest point is usually admissible, and a 1-NN query is much cheaper.
+    if (tree_->index.knnSearch(&p.x, 1, idx, dist2) == 1) {
+        float c = glm::dot(n, normals_[idx[0]]);
+        if (std::abs(c) >= threshold) return int(idx[0]) * 2 + (c >= 0.f ? 0 : 1);
+        if (params_.knn == 1) return -1;
+    }
+    const size_t found = tree_->index.knnSearch(&p.x, size_t(params_.knn), idx, dist2);
     for (size_t i = 0; i < found; ++i) {
         float c = glm::dot(n, normals_[idx[i]]);
         // Of the point's two hemispheres (n, -n), take the closer one if it is admissible.
@@ -277,8 +283,12 @@ size_t HemiField::bytes() const {
     // kd-tree: one index per point plus about two nodes per leaf.
     b += positions_.size() * sizeof(uint32_t) +
          (positions_.size() / kTreeLeafSize + 1) * 2 * sizeof(KdTree::Index::Node);
+    return b;
+}
+
+size_t HemiField::scratchBytes() const {
+    size_t b = merged_.capacity() * sizeof(Record) + regionStart_.capacity() * sizeof(uint64_t);
     for (const SlotBuffer& s : slots_) b += s.records.capacity() * sizeof(Record);
-    b += merged_.capacity() * sizeof(Record) + regionStart_.capacity() * sizeof(uint64_t);
     return b;
 }
 
@@ -291,11 +301,13 @@ std::string HemiField::describe() const {
     char buf[512];
     std::snprintf(buf, sizeof(buf),
                   "hemi: %zu points (%d hemispheres, %llu draws), %dx%d strata, alpha=%s, "
-                  "normal-angle=%g, knn=%d, init=%g, epsilon=%g, %.1f MiB; passes=%llu, "
-                  "records=%llu, rejected targets=%llu, rejected records=%llu",
+                  "normal-angle=%g, knn=%d, init=%g, epsilon=%g, %.1f MiB (+%.1f MiB record "
+                  "buffers); passes=%llu, records=%llu, rejected targets=%llu, "
+                  "rejected records=%llu",
                   positions_.size(), numRegions(), (unsigned long long)attempts_, params_.cols,
                   params_.rows, alpha, params_.normalAngleDeg, params_.knn, params_.init,
                   params_.epsilon, double(bytes()) / (1024.0 * 1024.0),
+                  double(scratchBytes()) / (1024.0 * 1024.0),
                   (unsigned long long)stats_.passes, (unsigned long long)stats_.records,
                   (unsigned long long)stats_.rejectedTargets,
                   (unsigned long long)stats_.rejectedRecords);

@@ -52,6 +52,8 @@ public:
     GuidingStats stats() const override;
 
     // Inspection (tests, tools).
+    // Bytes of the per-pass record buffers and endPass scratch (not counted in bytes()).
+    size_t scratchBytes() const;
     // Number of regions (hemispheres): twice the number of accepted surface points.
     int numRegions() const { return static_cast<int>(normals_.size() * 2); }
     const StrataLayout& layout() const { return layout_; }

@@ -235,6 +235,14 @@ TEST(HemiField, DefaultsAndMemory) {
     EXPECT_LE(f->bytes(), tables + 8192 * 64);
     EXPECT_LE(double(f->bytes()), 1.05 * hemiEstimatedBytes(f->params()));
     EXPECT_FALSE(f->describe().empty());
+    // Record buffers are scratch, reported apart from the learned data.
+    const size_t before = f->bytes();
+    f->beginPass(4);
+    for (int i = 0; i < 1000; ++i) f->record(i % 4, 0, glm::vec3(0, 0, 1), 1.f);
+    EXPECT_EQ(f->bytes(), before);
+    EXPECT_GE(f->scratchBytes(), 1000u * 12u);
+    f->endPass();
+    EXPECT_EQ(f->bytes(), before);
 }
 
 TEST(HemiField, LookupOnPlaneSidesAndAngle) {
