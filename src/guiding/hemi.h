@@ -37,6 +37,9 @@ public:
     // 2, 3, 5; failed or degenerate samples are skipped) and builds the kd-tree.
     HemiField(const HemiParams& params, const SceneInfo& scene);
     ~HemiField() override;
+    // The kd-tree refers to positions_: neither copyable nor movable.
+    HemiField(const HemiField&) = delete;
+    HemiField& operator=(const HemiField&) = delete;
 
     int lookup(const glm::vec3& p, const glm::vec3& n) const override;
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const override;
