@@ -5,5 +5,5 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 bash "$here/scripts/setup.sh"
 mkdir -p "$here/out"
 "$here/build/rlpbrt" "$here/scenes/demo/demo.pbrt" --outfile "$here/out/demo.exr" "$@"
-"$here/build/rlpbrt" "$here/scenes/demo/demo.pbrt" --outfile "$here/out/demo.png" --quiet "$@"
+"$here/build/rlpbrt-imgtool" convert "$here/out/demo.exr" "$here/out/demo.png"
 echo "demo: wrote $here/out/demo.exr and $here/out/demo.png"
