@@ -61,19 +61,6 @@ std::unique_ptr<Tokenizer> Tokenizer::fromFile(const std::string& path, Diagnost
             }
         }
     }
-    // Regular files are mapped (no copy, no zero-filled buffer); others are read.
-    if (S_ISREG(st.st_mode) && st.st_size > 0) {
-        int fd = ::open(path.c_str(), O_RDONLY);
-        if (fd >= 0) {
-            void* m = mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
-            ::close(fd);
-            if (m != MAP_FAILED) {
-                madvise(m, std::size_t(st.st_size), MADV_SEQUENTIAL);
-                return std::unique_ptr<Tokenizer>(
-                    new Tokenizer(m, std::size_t(st.st_size), diag.intern(path), diag));
-            }
-        }
-    }
     FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) {
         diag.error(includedFrom, "cannot open file \"" + path + "\"");
