@@ -97,6 +97,9 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (!parseUnsigned(value, 64, &u) || u < 1)
                 return bad(key, value, "an integer in 1..64");
             hp->knn = int(u);
+        } else if (key == "cosine") {
+            if (value != "0" && value != "1") return bad(key, value, "0 or 1");
+            hp->cosine = value == "1";
         } else if (key == "max-mb") {
             if (!parseDouble(value, &d) || !(d > 0.0)) return bad(key, value, "a positive number");
             *maxMiB = d;
@@ -105,7 +108,7 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "max-mb, mix)";
+                     "cosine, max-mb, mix)";
             return false;
         }
     }

@@ -90,7 +90,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     visits_.assign(regions * n, 0);
     cdf_.resize(regions * (n + 1));
     if (regions > 0) {
-        buildStrataCdf(q_.data(), strata_, params.epsilon, cdf_.data());
+        buildPolicy(q_.data(), cdf_.data());
         for (size_t r = 1; r < regions; ++r)
             std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
     }
@@ -234,7 +234,17 @@ void HemiField::applyRegion(int region, const Record* begin, const Record* end, 
         q[j] = (std::isfinite(updated) && updated >= 0.0) ? updated : mean;
         visits[j] += m;
     }
-    buildStrataCdf(q, strata_, params_.epsilon, &cdf_[size_t(region) * size_t(strata_ + 1)]);
+    buildPolicy(q, &cdf_[size_t(region) * size_t(strata_ + 1)]);
+}
+
+void HemiField::buildPolicy(const double* q, float* cdf) const {
+    if (!params_.cosine) {
+        buildStrataCdf(q, strata_, params_.epsilon, cdf);
+        return;
+    }
+    double qc[64 * 64];
+    for (int j = 0; j < strata_; ++j) qc[j] = q[j] * double(layout_.centre(j).z);
+    buildStrataCdf(qc, strata_, params_.epsilon, cdf);
 }
 
 void HemiField::endPass() {

@@ -335,8 +335,29 @@ TEST(HemiField, LookupNearCornerPicksFloorOrWallByNormal) {
     EXPECT_EQ(f->lookup(p, glm::normalize(glm::vec3(1, 0, 1))), -1);
 }
 
-TEST(HemiField, UntrainedSamplingMatchesPdf) {
+// With the cosine product (the default) the untrained policy is cosine-weighted per stratum:
+// still sampled exactly by its pdf, integrating to one, denser at the normal than at grazing
+// angles (ratio of the stratum-centre cosines, up to the epsilon floor).
+TEST(HemiField, CosineProductPolicyMatchesPdf) {
     auto f = makeHemi(cornerScene(), {{"points", "64"}});
+    ASSERT_TRUE(f);
+    for (int region : {0, 1, 63, 100}) {
+        chi2::SphereResult r = sphereTest(*f, region, 900 + uint64_t(region));
+        EXPECT_TRUE(r.passed) << "region " << region << ": " << r.message;
+        EXPECT_NEAR(strataIntegral(*f, region), 1.0, 1e-5);
+        chi2::Result exact = strataTest(*f, region, 950 + uint64_t(region), 200000);
+        EXPECT_TRUE(exact.passed) << "region " << region << ": " << exact.message;
+        glm::vec3 n = f->regionNormal(region);
+        glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0)
+                                                                        : glm::vec3(0, 1, 0)));
+        float top = f->pdf(region, n), grazing = f->pdf(region, glm::normalize(t + 0.02f * n));
+        EXPECT_GT(top, 1.0f / (2.0f * float(kPi)));
+        EXPECT_GT(top, 4.f * grazing);
+    }
+}
+
+TEST(HemiField, UntrainedSamplingMatchesPdf) {
+    auto f = makeHemi(cornerScene(), {{"points", "64"}, {"cosine", "0"}});
     ASSERT_TRUE(f);
     for (int region : {0, 1, 63, 100}) {
         chi2::SphereResult r = sphereTest(*f, region, 100 + uint64_t(region));
@@ -408,7 +429,8 @@ TEST(HemiField, SampleReportsPdfOfItsDirection) {
 }
 
 TEST(HemiField, RunningMeanConvergesToTargets) {
-    auto f = makeHemi(planeScene(), {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}});
+    auto f = makeHemi(planeScene(),
+                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}});
     ASSERT_TRUE(f);
     const int region = 2, n = f->layout().count();
     std::mt19937_64 rng(31);
@@ -433,7 +455,8 @@ TEST(HemiField, RunningMeanConvergesToTargets) {
         }
     }
     // Noise-free constant targets: Q equals T exactly after one pass.
-    auto g = makeHemi(planeScene(), {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}});
+    auto g = makeHemi(planeScene(),
+                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}});
     ASSERT_TRUE(g);
     g->beginPass(1);
     double total = 0.0;
