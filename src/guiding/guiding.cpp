@@ -103,12 +103,12 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         } else if (key == "max-mb") {
             if (!parseDouble(value, &d) || !(d > 0.0)) return bad(key, value, "a positive number");
             *maxMiB = d;
-        } else if (key == "mix") {
+        } else if (key == "mix" || key == "target") {
             // Consumed by the integrator.
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, max-mb, mix)";
+                     "cosine, max-mb, mix, target)";
             return false;
         }
     }

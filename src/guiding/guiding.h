@@ -67,6 +67,9 @@ public:
     // unit shading normal n, so a Lambertian y of albedo rho has scattered = rho / pi * this.
     // Same result as scatteredEstimate with fcos = max(0, dot(w, n)), without the callbacks.
     virtual float irradianceEstimate(int region, const glm::vec3& n) const;
+    // The learned incident radiance Q(region, stratum of w) (0 for an invalid region or a
+    // direction outside the region's hemisphere): for one-sample estimates of the Eq. 1 sum.
+    virtual float radiance(int region, const glm::vec3& w) const = 0;
 
     // Learning: during a pass, record that from `region` the direction w received target T
     // (T = Le + scatteredEstimate at the next vertex, or the environment radiance). `slot` is
@@ -102,7 +105,7 @@ public:
 //   knn          nearest points checked for an admissible normal, 1..64 (default 8)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
-//   mix          consumed by the integrator; accepted and ignored here
+//   mix, target  consumed by the integrator; accepted and ignored here
 std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
                                                  const SceneInfo& scene, std::string* error);
 

@@ -182,6 +182,12 @@ float HemiField::irradianceEstimate(int region, const glm::vec3& n) const {
     return static_cast<float>(std::min(result, double(FLT_MAX)));
 }
 
+float HemiField::radiance(int region, const glm::vec3& w) const {
+    int j = stratumOf(region, w);
+    if (j < 0) return 0.f;
+    return static_cast<float>(std::min(q_[index(region, j)], double(FLT_MAX)));
+}
+
 void HemiField::beginPass(int numSlots) {
     numSlots = std::max(numSlots, 0);
     if (slots_.size() != size_t(numSlots)) slots_.resize(size_t(numSlots));

@@ -52,6 +52,7 @@ public:
     float scatteredEstimate(int region,
                             const std::function<float(const glm::vec3&)>& fcos) const override;
     float irradianceEstimate(int region, const glm::vec3& n) const override;
+    float radiance(int region, const glm::vec3& w) const override;
     void beginPass(int numSlots) override;
     void record(int slot, int region, const glm::vec3& w, float target) override;
     void endPass() override;

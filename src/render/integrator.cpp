@@ -47,6 +47,14 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
         }
         settings->mix = mix;
     }
+    auto target = config.params.find("target");
+    if (target != config.params.end()) {
+        if (target->second != "sum" && target->second != "sample") {
+            *error = "target must be \"sum\" or \"sample\", got \"" + target->second + "\"";
+            return false;
+        }
+        settings->sampledTarget = target->second == "sample";
+    }
     if (config.backend == "none") return true;
     guiding::SceneInfo info;
     info.boundsMin = scene.boundsMin();
@@ -168,6 +176,7 @@ float PathIntegrator::scatteredTarget(const SurfaceInteraction& si, const BSDF& 
         else lambertian = false;
     }
     if (lambertian) return luminance(albedo) * InvPi * guide_.field->irradianceEstimate(region, n);
+    if (guide_.sampledTarget) return -1.f;  // estimated with the direction sampled at y
     struct Ctx {
         const BSDF& bsdf;
         Vec3 wo, n;
@@ -255,9 +264,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
         // y, carried unchanged through delta vertices.
+        bool deferTarget = false;
         if (learn && pending.active()) {
-            if (region >= 0)
-                flush(emitted + scatteredTarget(si, bsdf, region, si.wo));
+            float scattered = region >= 0 ? scatteredTarget(si, bsdf, region, si.wo) : 0.f;
+            if (region >= 0 && scattered < 0.f && bounces < maxDepth_)
+                deferTarget = true;  // completed below with the direction sampled at y
+            else if (region >= 0)
+                flush(emitted + std::max(scattered, 0.f));
             else if (canGuide || bsdf.numComponents() == 0)
                 pending = PendingRecord();  // no data at y: nothing to learn from
             else
@@ -271,6 +284,14 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats);
         // Sample the next direction (the guiding seam).
         DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, sampler);
+        if (deferTarget) {
+            // One-sample estimate of the Eq. 1 sum: Q(y, w') f(w') cos / pdf(w').
+            float est = 0.f;
+            if (ds.pdf > 0.f && !ds.transmission)
+                est = field->radiance(region, ds.wi) * luminance(ds.f) *
+                      std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
+            flush(emitted + (std::isfinite(est) ? est : 0.f));
+        }
         if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
         Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
         beta *= weight;

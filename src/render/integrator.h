@@ -36,6 +36,11 @@ struct GuideSettings {
     // (one-sample MIS mixture with BSDF sampling): 0 = BSDF only, 1 = the paper's pure policy.
     float mix = 0.5f;
     bool learn = true;  // record Eq. 1 targets during rendering
+    // How the sum of Eq. 1 is evaluated at a non-Lambertian vertex y: over all strata
+    // (n BSDF evaluations, the paper's form) or with the one direction sampled at y
+    // (Q(y, w') f cos / pdf: an unbiased one-sample estimate of the same sum, no extra
+    // evaluations). Lambertian vertices always use the exact sum (learned irradiance).
+    bool sampledTarget = true;
 };
 
 class PathIntegrator {
