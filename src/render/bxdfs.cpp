@@ -74,16 +74,22 @@ Spectrum Fresnel::evaluate(float cosThetaI) const {
 
 Spectrum LambertianReflection::f(const Vec3&, const Vec3&) const { return r * InvPi; }
 
-BxDFSample LambertianReflection::sampleF(const Vec3& wo, float, Vec2 u) const {
+// Cosine-weighted sampling on wo's side, shared by the diffuse reflection lobes.
+template <typename Lobe>
+BxDFSample sampleCosineReflection(const Lobe& lobe, const Vec3& wo, Vec2 u) {
     BxDFSample s;
     Vec3 wi = sampleCosineHemisphere(u);
     if (wo.z < 0.f) wi.z = -wi.z;
-    s.pdf = pdf(wo, wi);
+    s.pdf = lobe.pdf(wo, wi);
     if (s.pdf == 0.f) return BxDFSample();
     s.wi = wi;
-    s.f = f(wo, wi);
-    s.flags = flags();
+    s.f = lobe.f(wo, wi);
+    s.flags = lobe.flags();
     return s;
+}
+
+BxDFSample LambertianReflection::sampleF(const Vec3& wo, float, Vec2 u) const {
+    return sampleCosineReflection(*this, wo, u);
 }
 
 float LambertianReflection::pdf(const Vec3& wo, const Vec3& wi) const {
@@ -139,15 +145,7 @@ Spectrum OrenNayar::f(const Vec3& wo, const Vec3& wi) const {
 }
 
 BxDFSample OrenNayar::sampleF(const Vec3& wo, float, Vec2 u) const {
-    BxDFSample s;
-    Vec3 wi = sampleCosineHemisphere(u);
-    if (wo.z < 0.f) wi.z = -wi.z;
-    s.pdf = pdf(wo, wi);
-    if (s.pdf == 0.f) return BxDFSample();
-    s.wi = wi;
-    s.f = f(wo, wi);
-    s.flags = flags();
-    return s;
+    return sampleCosineReflection(*this, wo, u);
 }
 
 float OrenNayar::pdf(const Vec3& wo, const Vec3& wi) const {
