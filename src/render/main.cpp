@@ -84,6 +84,9 @@ int main(int argc, char** argv) {
                    "points, normal-angle, init, epsilon, knn");
     app.add_option("--stats", statsFile, "write run statistics as JSON");
     CLI11_PARSE(app, argc, argv);
+    // From here on SIGINT/SIGTERM finish the current pass and write the image so far.
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
 
     Diagnostics diag;
     double t0 = seconds();
@@ -145,8 +148,6 @@ int main(int argc, char** argv) {
     const float mix = guideSettings.mix;
 
     if (outFile.empty()) outFile = defaultOutput(*scene);
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
     RenderOptions ro;
     ro.nThreads = nThreads;
     ro.timeBudget = timeBudget;
