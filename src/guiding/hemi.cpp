@@ -54,7 +54,8 @@ struct HemiField::KdTree {
 
 double hemiEstimatedBytes(const HemiParams& p) {
     const double n = double(p.cols) * double(p.rows);
-    const double perRegion = n * (sizeof(double) + sizeof(uint64_t)) + (n + 1) * sizeof(float);
+    const double perRegion =
+        n * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) + (n + 1) * sizeof(float);
     // Per point: position, normal, kd-tree index entry and a share of the tree nodes.
     const double perPoint = 2 * sizeof(glm::vec3) + sizeof(uint32_t) + 16.0;
     return double(p.points) * (2.0 * perRegion + perPoint);
@@ -87,6 +88,12 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
 
     const size_t regions = positions_.size() * 2, n = size_t(strata_);
     q_.assign(regions * n, params.init);
+    qf_.assign(regions * n, float(std::min(params.init, double(FLT_MAX))));
+    for (int j = 0; j < strata_; ++j) {
+        centreX_.push_back(layout_.centre(j).x);
+        centreY_.push_back(layout_.centre(j).y);
+        centreZ_.push_back(layout_.centre(j).z);
+    }
     visits_.assign(regions * n, 0);
     cdf_.resize(regions * (n + 1));
     if (regions > 0) {
@@ -172,13 +179,16 @@ float HemiField::irradianceEstimate(int region, const glm::vec3& n) const {
     if (!validRegion(region) || !finite3(n)) return 0.f;
     HemiFrame frame = HemiFrame::fromZ(regionNormal(region));
     const glm::vec3 nl = frame.toLocal(n);
-    const double* q = &q_[index(region, 0)];
-    double acc = 0.0;
+    // Float copy of Q and per-axis centres: a short, vectorizable loop (this runs at every
+    // Lambertian path vertex that completes a training record).
+    const float* q = &qf_[index(region, 0)];
+    const float *cx = centreX_.data(), *cy = centreY_.data(), *cz = centreZ_.data();
+    float acc = 0.f;
     for (int j = 0; j < strata_; ++j) {
-        float c = glm::dot(layout_.centre(j), nl);
-        if (c > 0.f) acc += q[j] * double(c);
+        float c = cx[j] * nl.x + cy[j] * nl.y + cz[j] * nl.z;
+        acc += q[j] * std::max(c, 0.f);
     }
-    double result = acc * layout_.stratumSolidAngle();
+    double result = double(acc) * layout_.stratumSolidAngle();
     return static_cast<float>(std::min(result, double(FLT_MAX)));
 }
 
@@ -241,6 +251,13 @@ void HemiField::applyRegion(int region, const Record* begin, const Record* end, 
         visits[j] += m;
     }
     buildPolicy(q, &cdf_[size_t(region) * size_t(strata_ + 1)]);
+    mirrorRegion(region);
+}
+
+void HemiField::mirrorRegion(int region) {
+    const double* q = &q_[index(region, 0)];
+    float* qf = &qf_[index(region, 0)];
+    for (int j = 0; j < strata_; ++j) qf[j] = float(std::min(q[j], double(FLT_MAX)));
 }
 
 void HemiField::buildPolicy(const double* q, float* cdf) const {
@@ -293,7 +310,8 @@ void HemiField::endPass() {
 }
 
 size_t HemiField::bytes() const {
-    size_t b = q_.capacity() * sizeof(double) + visits_.capacity() * sizeof(uint64_t) +
+    size_t b = q_.capacity() * sizeof(double) + qf_.capacity() * sizeof(float) +
+               visits_.capacity() * sizeof(uint64_t) +
                cdf_.capacity() * sizeof(float) +
                (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3);
     // kd-tree: one index per point plus about two nodes per leaf.

@@ -86,6 +86,8 @@ public:
 private:
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;
+    // Refreshes the float copy of one region's Q.
+    void mirrorRegion(int region);
     struct Record {
         uint32_t region;
         uint16_t stratum;
@@ -115,6 +117,8 @@ private:
     std::vector<glm::vec3> normals_;    // unit geometric normal per surface sample
     std::unique_ptr<KdTree> tree_;
     std::vector<double> q_;          // Q per (region, stratum)
+    std::vector<float> qf_;          // Q in float (clamped), read by the per-vertex estimates
+    std::vector<float> centreX_, centreY_, centreZ_;  // stratum centres (local), per axis
     std::vector<uint64_t> visits_;   // applied targets per (region, stratum)
     std::vector<float> cdf_;         // frozen policy: strata_ + 1 entries per region
     std::vector<SlotBuffer> slots_;  // per-pass record buffers
