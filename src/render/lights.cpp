@@ -116,16 +116,22 @@ bool fillPointSample(const Vec3& pLight, const LightSampleContext& ctx, const Sp
 // ---------------------------------------------------------------------------------------
 // point
 
-class PointLight final : public Light {
+// Lights at a point or from one direction: sampled only by sampleLi, never hit by rays.
+template <LightKind Kind>
+class DeltaLight : public Light {
 public:
-    PointLight(const Vec3& p, const Spectrum& I) : p_(p), I_(I) {}
-    LightKind kind() const override { return LightKind::DeltaPosition; }
-    bool sampleLi(const LightSampleContext& ctx, Vec2, LightSample* s) const override {
-        return fillPointSample(p_, ctx, I_, s);
-    }
+    LightKind kind() const override { return Kind; }
     float pdfLi(const LightSampleContext&, const Vec3&, const Vec3&,
                 const Vec3&) const override {
         return 0.f;
+    }
+};
+
+class PointLight final : public DeltaLight<LightKind::DeltaPosition> {
+public:
+    PointLight(const Vec3& p, const Spectrum& I) : p_(p), I_(I) {}
+    bool sampleLi(const LightSampleContext& ctx, Vec2, LightSample* s) const override {
+        return fillPointSample(p_, ctx, I_, s);
     }
     Spectrum power() const override { return 4.f * Pi * I_; }
 
@@ -137,7 +143,7 @@ private:
 // ---------------------------------------------------------------------------------------
 // spot
 
-class SpotLight final : public Light {
+class SpotLight final : public DeltaLight<LightKind::DeltaPosition> {
 public:
     SpotLight(const Mat4& worldFromLight, const Spectrum& I, float totalWidthDeg,
               float falloffStartDeg)
@@ -146,7 +152,6 @@ public:
           I_(I),
           cosTotalWidth_(std::cos(radians(totalWidthDeg))),
           cosFalloffStart_(std::cos(radians(falloffStartDeg))) {}
-    LightKind kind() const override { return LightKind::DeltaPosition; }
 
     // pbrt-v3's smooth quartic falloff for the world direction w leaving the light.
     float falloff(const Vec3& w) const {
@@ -162,10 +167,6 @@ public:
         s->L *= falloff(-s->wi);
         return s->valid();
     }
-    float pdfLi(const LightSampleContext&, const Vec3&, const Vec3&,
-                const Vec3&) const override {
-        return 0.f;
-    }
     Spectrum power() const override {
         return I_ * 2.f * Pi * (1.f - 0.5f * (cosFalloffStart_ + cosTotalWidth_));
     }
@@ -180,7 +181,7 @@ private:
 // ---------------------------------------------------------------------------------------
 // goniometric
 
-class GoniometricLight final : public Light {
+class GoniometricLight final : public DeltaLight<LightKind::DeltaPosition> {
 public:
     GoniometricLight(const Mat4& worldFromLight, const Spectrum& I,
                      std::shared_ptr<MipMap<Spectrum>> map)
@@ -188,7 +189,6 @@ public:
           p_(transformPoint(worldFromLight, Vec3(0.f))),
           I_(I),
           map_(std::move(map)) {}
-    LightKind kind() const override { return LightKind::DeltaPosition; }
 
     // The map value for the world direction w leaving the light; the map's polar axis is
     // the light's +y (pbrt-v3 swaps y and z before the spherical lookup).
@@ -204,10 +204,6 @@ public:
         s->L *= scale(-s->wi);
         return s->valid();
     }
-    float pdfLi(const LightSampleContext&, const Vec3&, const Vec3&,
-                const Vec3&) const override {
-        return 0.f;
-    }
     Spectrum power() const override {
         return 4.f * Pi * I_ * (map_ ? averageMap(*map_) : Spectrum(1.f));
     }
@@ -222,7 +218,7 @@ private:
 // ---------------------------------------------------------------------------------------
 // projection
 
-class ProjectionLight final : public Light {
+class ProjectionLight final : public DeltaLight<LightKind::DeltaPosition> {
 public:
     ProjectionLight(const Mat4& worldFromLight, const Spectrum& I, float fovDeg,
                     std::shared_ptr<MipMap<Spectrum>> map, int mapWidth, int mapHeight)
@@ -243,7 +239,6 @@ public:
         float tanDiag = tanHalfFov_ * std::sqrt(1.f + 1.f / (aspect * aspect));
         cosTotalWidth_ = std::cos(std::atan(tanDiag));
     }
-    LightKind kind() const override { return LightKind::DeltaPosition; }
 
     // The projected value for the world direction w leaving the light (pbrt-v3's
     // perspective projection with near plane 1e-3; screen window [-aspect,aspect]x[-1,1]).
@@ -263,10 +258,6 @@ public:
         s->L *= projection(-s->wi);
         return s->valid();
     }
-    float pdfLi(const LightSampleContext&, const Vec3&, const Vec3&,
-                const Vec3&) const override {
-        return 0.f;
-    }
     Spectrum power() const override {
         return (map_ ? averageMap(*map_) : Spectrum(1.f)) * I_ * 2.f * Pi *
                (1.f - cosTotalWidth_);
@@ -284,10 +275,9 @@ private:
 // ---------------------------------------------------------------------------------------
 // distant
 
-class DistantLight final : public Light {
+class DistantLight final : public DeltaLight<LightKind::DeltaDirection> {
 public:
     DistantLight(const Spectrum& L, const Vec3& wLight) : L_(L), w_(wLight) {}
-    LightKind kind() const override { return LightKind::DeltaDirection; }
     bool sampleLi(const LightSampleContext&, Vec2, LightSample* s) const override {
         *s = LightSample();
         s->isDelta = true;
@@ -296,10 +286,6 @@ public:
         s->dist = Infinity;
         s->L = L_;
         return s->valid();
-    }
-    float pdfLi(const LightSampleContext&, const Vec3&, const Vec3&,
-                const Vec3&) const override {
-        return 0.f;
     }
     Spectrum power() const override { return L_ * Pi * radius_ * radius_; }
     void preprocess(const Vec3&, float sceneRadius) override { radius_ = sceneRadius; }
