@@ -1,7 +1,8 @@
 // Light selection for next-event estimation, pbrt-v3's three strategies:
 //  - "uniform": every light equally likely;
 //  - "power": proportional to emitted power;
-//  - "spatial" (pbrt-v3's default): a voxel grid over the scene bounds; each voxel, the first
+//  - "spatial" (pbrt-v3's default): a voxel grid over the scene bounds (64 voxels along the
+//    longest axis as pbrt-v3 with more than 8 lights, 16 with fewer); each voxel, the first
 //    time a point in it asks, estimates every light's contribution at 128 points inside it
 //    (luminance of Li / pdf, no visibility) and samples lights proportionally, with a floor
 //    of 0.1% of the average so that no light has zero probability.
