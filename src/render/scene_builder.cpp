@@ -119,10 +119,7 @@ void SceneBuilder::setOption(Entity& e, const char* directive, const std::string
                              ParamList&& params, const FileLoc& loc) {
     if (!beforeWorld(directive, loc)) return;
     // Repeated directives: the last one wins, as in pbrt-v3.
-    e.type = type;
-    e.params = std::move(params);
-    e.loc = loc;
-    e.present = true;
+    e.assign(type, std::move(params), loc);
 }
 
 void SceneBuilder::camera(const std::string& type, ParamList params, FileLoc loc) {
@@ -162,10 +159,8 @@ void SceneBuilder::makeNamedMedium(const std::string& name, ParamList params, Fi
         }
     MediumEntity m;
     m.name = name;
-    m.params = std::move(params);
+    m.assign(std::move(params), loc);
     m.type = m.params.getString("type", "");
-    m.loc = loc;
-    m.present = true;
     m.worldFromMedium = gs_.ctm[0];
     if (m.type.empty()) {
         diag_.error(loc, "MakeNamedMedium \"" + name + "\" has no \"string type\"");
@@ -274,9 +269,7 @@ void SceneBuilder::texture(const std::string& name, const std::string& type,
     t.name = name;
     t.type = texClass;
     t.isFloat = isFloat;
-    t.params = std::move(params);
-    t.loc = loc;
-    t.present = true;
+    t.assign(std::move(params), loc);
     t.worldFromTexture = gs_.ctm[0];
     t.textures = gs_.textures;
     int index = int(desc_.textures.size());
@@ -291,10 +284,7 @@ void SceneBuilder::texture(const std::string& name, const std::string& type,
 void SceneBuilder::material(const std::string& type, ParamList params, FileLoc loc) {
     if (!inWorld("Material", loc)) return;
     MaterialEntity m;
-    m.type = type;
-    m.params = std::move(params);
-    m.loc = loc;
-    m.present = true;
+    m.assign(type, std::move(params), loc);
     m.textures = gs_.textures;
     gs_.material = int(desc_.materials.size());
     desc_.materials.push_back(std::move(m));
@@ -304,9 +294,7 @@ void SceneBuilder::makeNamedMaterial(const std::string& name, ParamList params, 
     if (!inWorld("MakeNamedMaterial", loc)) return;
     MaterialEntity m;
     m.name = name;
-    m.params = std::move(params);
-    m.loc = loc;
-    m.present = true;
+    m.assign(std::move(params), loc);
     m.textures = gs_.textures;
     const Param* t = m.params.find("type");
     if (!t || t->type != ParamType::String || t->strings.empty()) {
@@ -341,10 +329,7 @@ void SceneBuilder::lightSource(const std::string& type, ParamList params, FileLo
         return;
     }
     LightEntity l;
-    l.type = type;
-    l.params = std::move(params);
-    l.loc = loc;
-    l.present = true;
+    l.assign(type, std::move(params), loc);
     l.worldFromLight = gs_.ctm[0];
     l.outsideMedium = gs_.outside;
     desc_.lights.push_back(std::move(l));
@@ -353,10 +338,7 @@ void SceneBuilder::lightSource(const std::string& type, ParamList params, FileLo
 void SceneBuilder::areaLightSource(const std::string& type, ParamList params, FileLoc loc) {
     if (!inWorld("AreaLightSource", loc)) return;
     Entity e;
-    e.type = type;
-    e.params = std::move(params);
-    e.loc = loc;
-    e.present = true;
+    e.assign(type, std::move(params), loc);
     gs_.areaLight = int(desc_.areaLights.size());
     desc_.areaLights.push_back(std::move(e));
 }
@@ -366,10 +348,7 @@ void SceneBuilder::shape(const std::string& type, ParamList params, FileLoc loc)
     checkStatic(loc);
     if (!checkMedia(loc)) return;
     ShapeEntity s;
-    s.type = type;
-    s.params = std::move(params);
-    s.loc = loc;
-    s.present = true;
+    s.assign(type, std::move(params), loc);
     s.worldFromObject = gs_.ctm[0];
     s.reverseOrientation = gs_.reverseOrientation;
     s.material = gs_.material;

@@ -18,6 +18,17 @@ struct Entity {
     ParamList params;
     FileLoc loc;
     bool present = false;  // false: the directive was absent; pbrt-v3's default applies
+
+    // Records the directive's parameters and location (it is now present).
+    void assign(ParamList&& p, const FileLoc& l) {
+        params = std::move(p);
+        loc = l;
+        present = true;
+    }
+    void assign(const std::string& t, ParamList&& p, const FileLoc& l) {
+        type = t;
+        assign(std::move(p), l);
+    }
 };
 
 // Named textures visible at one point of the file (copied on write, shared otherwise).
