@@ -63,9 +63,11 @@ public:
     // count as 0; the result is finite and >= 0 (0 for an invalid region).
     virtual float scatteredEstimate(int region,
                                     const std::function<float(const glm::vec3&)>& fcos) const = 0;
-    // (2pi/n) * sum_j Q(y,j) * max(0, dot(w_j, n)): the irradiance estimate at a region for a
-    // unit shading normal n, so a Lambertian y of albedo rho has scattered = rho / pi * this.
-    // Same result as scatteredEstimate with fcos = max(0, dot(w, n)), without the callbacks.
+    // The irradiance estimate at a region for a unit shading normal n, so a Lambertian y of
+    // albedo rho has scattered = rho / pi * this: (2pi/n) * sum_j Q(y,j) * max(0, dot(w_j, n))
+    // by default (scatteredEstimate with fcos = max(0, dot(w, n)), without the callbacks). A
+    // backend may return a cheaper estimate that is exact for n = the region's normal: hemi
+    // returns max(0, dot(M, n)) with the precomputed moment M = (2pi/n) sum_j Q(y,j) w_j.
     virtual float irradianceEstimate(int region, const glm::vec3& n) const;
     // The learned incident radiance Q(region, stratum of w) (0 for an invalid region or a
     // direction outside the region's hemisphere): for one-sample estimates of the Eq. 1 sum.

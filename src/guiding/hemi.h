@@ -13,6 +13,7 @@
 
 #include "guiding/directional.h"
 #include "guiding/guiding.h"
+#include "guiding/kdtree.h"
 
 namespace rlpbrt::guiding {
 
@@ -42,7 +43,7 @@ public:
     // 2, 3, 5; failed or degenerate samples are skipped) and builds the kd-tree.
     HemiField(const HemiParams& params, const SceneInfo& scene);
     ~HemiField() override;
-    // The kd-tree refers to positions_: neither copyable nor movable.
+    // Large tables: not copyable.
     HemiField(const HemiField&) = delete;
     HemiField& operator=(const HemiField&) = delete;
 
@@ -86,8 +87,8 @@ public:
 private:
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;
-    // Refreshes the float copy of one region's Q.
-    void mirrorRegion(int region);
+    // Refreshes the irradiance moment of one region from its Q.
+    void updateMoment(int region);
     struct Record {
         uint32_t region;
         uint16_t stratum;
@@ -98,13 +99,14 @@ private:
         uint64_t rejectedTargets = 0;
         uint64_t rejectedRecords = 0;
     };
-    struct KdTree;  // nanoflann index over positions_, defined in hemi.cpp
 
     size_t index(int region, int stratum) const {
         return size_t(region) * size_t(strata_) + size_t(stratum);
     }
     bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
     const float* cdf(int region) const { return &cdf_[size_t(region) * size_t(strata_ + 1)]; }
+    // Starts loading the data the per-vertex queries read for a region; returns region.
+    int prefetched(int region) const;
     // Applies one region's records [begin, end) and rebuilds its CDF.
     void applyRegion(int region, const Record* begin, const Record* end, double* sums,
                      uint64_t* counts);
@@ -115,10 +117,15 @@ private:
     float cosMaxAngle_;
     std::vector<glm::vec3> positions_;  // one per surface sample
     std::vector<glm::vec3> normals_;    // unit geometric normal per surface sample
-    std::unique_ptr<KdTree> tree_;
+    std::unique_ptr<PointKdTree> tree_;
     std::vector<double> q_;          // Q per (region, stratum)
-    std::vector<float> qf_;          // Q in float (clamped), read by the per-vertex estimates
-    std::vector<float> centreX_, centreY_, centreZ_;  // stratum centres (local), per axis
+    // Per region, one cache line: the frame of its hemisphere (z = normal) and the moment
+    // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j.
+    struct alignas(64) RegionFrame {
+        HemiFrame frame;
+        glm::vec3 moment{0.f};
+    };
+    std::vector<RegionFrame> frames_;
     std::vector<uint64_t> visits_;   // applied targets per (region, stratum)
     std::vector<float> cdf_;         // frozen policy: strata_ + 1 entries per region
     std::vector<SlotBuffer> slots_;  // per-pass record buffers

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 #include <dlfcn.h>
@@ -335,6 +336,24 @@ bool writeImage(const std::string& path, const Image& img,
     }
     if (!ok) return false;
 
+    if (std::rename(tmp.name().c_str(), path.c_str()) != 0) {
+        return fail(error, "cannot rename \"" + tmp.name() + "\" to \"" + path +
+                               "\": " + std::strerror(errno));
+    }
+    tmp.release();
+    return true;
+}
+
+bool writeFileAtomically(const std::string& path, const std::string& content,
+                         std::string* error) {
+    TempFile tmp(path, "", error);
+    if (tmp.name().empty()) return false;
+    {
+        std::ofstream f(tmp.name(), std::ios::binary | std::ios::trunc);
+        f.write(content.data(), std::streamsize(content.size()));
+        f.close();
+        if (!f) return fail(error, "cannot write \"" + tmp.name() + "\"");
+    }
     if (std::rename(tmp.name().c_str(), path.c_str()) != 0) {
         return fail(error, "cannot rename \"" + tmp.name() + "\" to \"" + path +
                                "\": " + std::strerror(errno));

@@ -68,6 +68,11 @@ bool writeImage(const std::string& path, const Image& img,
                 const std::vector<std::pair<std::string, std::string>>& metadata,
                 std::string* error);
 
+// Writes `content` to path atomically (temporary file in the same directory, then rename);
+// nothing is left behind on failure.
+bool writeFileAtomically(const std::string& path, const std::string& content,
+                         std::string* error);
+
 // sRGB decoding (IEC 61966-2-1), as pbrt-v3's InverseGammaCorrect: v <= 0.04045 ? v / 12.92
 // : ((v + 0.055) / 1.055)^2.4. Encoded value in, linear value out.
 float srgbToLinear(float v);

@@ -262,12 +262,21 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
             region = field->lookup(si.p, nFacing);
         }
+        const bool lastVertex = bounces >= maxDepth_;
+        const int sampleRegion = guide_.mix > 0.f ? region : -1;
+        // Next-event estimation at non-specular vertices (first: its shadow ray gives the
+        // guide's prefetch of the region's tables time to land).
+        if (!lastVertex) {
+            ++stats.vertices;
+            if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
+                L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats);
+        }
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
         // y, carried unchanged through delta vertices.
         bool deferTarget = false;
         if (learn && pending.active()) {
             float scattered = region >= 0 ? scatteredTarget(si, bsdf, region, si.wo) : 0.f;
-            if (region >= 0 && scattered < 0.f && bounces < maxDepth_)
+            if (region >= 0 && scattered < 0.f && !lastVertex)
                 deferTarget = true;  // completed below with the direction sampled at y
             else if (region >= 0)
                 flush(emitted + std::max(scattered, 0.f));
@@ -276,12 +285,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             else
                 pending.target += pending.weight * emitted;  // delta y: continue the chain
         }
-        if (bounces >= maxDepth_) break;
-        ++stats.vertices;
-        const int sampleRegion = guide_.mix > 0.f ? region : -1;
-        // Next-event estimation at non-specular vertices.
-        if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
-            L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats);
+        if (lastVertex) break;
         // Sample the next direction (the guiding seam).
         DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, sampler);
         if (deferTarget) {

@@ -13,6 +13,7 @@
 
 #include "parser/diagnostics.h"
 #include "render/image_io.h"
+#include "render/metrics.h"
 #include "render/render.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
@@ -59,7 +60,7 @@ std::string defaultOutput(const Scene& scene) {
 
 int main(int argc, char** argv) {
     CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
-    std::string scenePath, outFile, statsFile, guide = "none";
+    std::string scenePath, outFile, statsFile, guide = "none", curveFile, refFile;
     bool parseOnly = false, quiet = false;
     int spp = 0, nThreads = 0;
     double timeBudget = 0.0;
@@ -83,6 +84,11 @@ int main(int argc, char** argv) {
                    "guiding parameter key=value (repeatable): mix, alpha, strata (WxH), "
                    "points, normal-angle, init, epsilon, knn");
     app.add_option("--stats", statsFile, "write run statistics as JSON");
+    auto* refOpt = app.add_option("--ref", refFile, "reference image for --curve (same size as "
+                                                    "the film's output)");
+    app.add_option("--curve", curveFile, "write seconds,spp,relmse against --ref after each "
+                                         "pass to this CSV file")
+        ->needs(refOpt);
     CLI11_PARSE(app, argc, argv);
     // From here on SIGINT/SIGTERM finish the current pass and write the image so far.
     std::signal(SIGINT, onSignal);
@@ -149,6 +155,38 @@ int main(int argc, char** argv) {
 
     if (outFile.empty()) outFile = defaultOutput(*scene);
     RenderOptions ro;
+    // Error curve: relMSE against the reference after each pass, computed while its cost
+    // stays under 1% of the render time so far (passes are skipped otherwise), with that
+    // cost subtracted from the seconds column. Rows are written when the render ends.
+    Image reference;
+    std::vector<std::string> curveRows;
+    double curveCost = 0.0;
+    int lastCurveSpp = 0;
+    if (!curveFile.empty()) {
+        std::string rerr;
+        if (!readImage(refFile, &reference, &rerr)) {
+            std::fprintf(stderr, "%s: error: %s\n", refFile.c_str(), rerr.c_str());
+            return 1;
+        }
+        const Bounds2i pb = scene->filmParams.pixelBounds();
+        if (reference.width != pb.width() || reference.height != pb.height() ||
+            reference.channels < 3) {
+            std::fprintf(stderr, "%s: error: reference is %dx%d with %d channels; the film "
+                                 "gives %dx%d RGB\n", refFile.c_str(), reference.width,
+                         reference.height, reference.channels, pb.width(), pb.height());
+            return 1;
+        }
+        ro.onPass = [&](int passSpp, double elapsed, const Film& film) {
+            if (curveCost > 0.01 * elapsed) return;
+            const double tc = seconds();
+            const double e = relMseTrimmed(film.toImage(), reference);
+            char row[96];
+            std::snprintf(row, sizeof(row), "%.6f,%d,%.9g", elapsed - curveCost, passSpp, e);
+            curveRows.push_back(row);
+            lastCurveSpp = passSpp;
+            curveCost += seconds() - tc;
+        };
+    }
     ro.nThreads = nThreads;
     ro.timeBudget = timeBudget;
     ro.progress = !quiet && isatty(STDERR_FILENO);
@@ -168,6 +206,21 @@ int main(int argc, char** argv) {
     if (!writeImage(outFile, r.image, meta, &err)) {
         std::fprintf(stderr, "%s: error: %s\n", outFile.c_str(), err.c_str());
         return 1;
+    }
+    if (!curveFile.empty()) {
+        // The last pass always has a row (the cost rule may have skipped it).
+        if (r.spp > 0 && (curveRows.empty() || lastCurveSpp != r.spp)) {
+            char row[96];
+            std::snprintf(row, sizeof(row), "%.6f,%d,%.9g", r.seconds - curveCost, r.spp,
+                          relMseTrimmed(r.image, reference));
+            curveRows.push_back(row);
+        }
+        std::string content = "seconds,spp,relmse\n";
+        for (const std::string& row : curveRows) content += row + "\n";
+        if (!writeFileAtomically(curveFile, content, &err)) {
+            std::fprintf(stderr, "%s: error: %s\n", curveFile.c_str(), err.c_str());
+            return 1;
+        }
     }
     if (r.stats.nonFinite > 0)
         std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n",
