@@ -11,6 +11,8 @@ namespace rlpbrt::guiding {
 
 GuidingField::~GuidingField() = default;
 
+float GuidingField::confidence(int region) const { return region >= 0 ? 1.f : 0.f; }
+
 float GuidingField::irradianceEstimate(int region, const glm::vec3& n) const {
     return scatteredEstimate(region,
                              [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
@@ -97,6 +99,10 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (!parseUnsigned(value, 64, &u) || u < 1)
                 return bad(key, value, "an integer in 1..64");
             hp->knn = int(u);
+        } else if (key == "warmup") {
+            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
+                return bad(key, value, "a number in [0, 1e9]");
+            hp->warmup = d;
         } else if (key == "cosine") {
             if (value != "0" && value != "1") return bad(key, value, "0 or 1");
             hp->cosine = value == "1";
@@ -108,7 +114,7 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, max-mb, mix, target)";
+                     "cosine, warmup, max-mb, mix, target)";
             return false;
         }
     }

@@ -2,7 +2,7 @@
 // queries per vertex (lookup, sample, pdf), feeds with training targets (record) and updates
 // between passes (endPass), after Dahm & Keller 2017, "Learning Light Transport the
 // Reinforced Way". Backends are created by name through createGuidingField, the only place
-// that names them. Depends on the standard library, GLM, TBB and nanoflann only.
+// that names them. Depends on the standard library, GLM and TBB only.
 #pragma once
 
 #include <cstddef>
@@ -73,6 +73,11 @@ public:
     // direction outside the region's hemisphere): for one-sample estimates of the Eq. 1 sum.
     virtual float radiance(int region, const glm::vec3& w) const = 0;
 
+    // How far the policy of `region` is trusted, in [0, 1] (0 for an invalid region): the
+    // integrator multiplies its guide/BSDF mixture probability by it, so regions with little
+    // data sample mostly the BSDF. Frozen between passes like the policy. Default: 1.
+    virtual float confidence(int region) const;
+
     // Learning: during a pass, record that from `region` the direction w received target T
     // (T = Le + scatteredEstimate at the next vertex, or the environment radiance). `slot` is
     // the caller's work-item index (film tile) in [0, numSlots): records are merged in slot
@@ -105,6 +110,9 @@ public:
 //   init         initial Q, positive and <= 3.4e38 (default 1e-3)
 //   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)
 //   knn          nearest points checked for an admissible normal, 1..64 (default 8)
+//   warmup       records per stratum until a region's policy gets the full mixture weight:
+//                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 16;
+//                0 = always full weight, the paper's behaviour)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
 //   mix, target  consumed by the integrator; accepted and ignored here

@@ -32,6 +32,11 @@ struct HemiParams {
     // integrand, which sampling by Q alone spends on grazing directions. Measured at 64 spp:
     // cornell-box relMSE 0.00105 -> 0.00091, veach-bidir 0.426 -> 0.347.
     bool cosine = true;
+    // Confidence of a region = visits / (visits + warmup * strata): the integrator scales its
+    // mixture probability by it, so barely trained regions sample mostly the BSDF. Measured at
+    // 64 spp (relMSE; none: 0.331, 6.95, 0.0176): warmup 1 -> veach-bidir 0.345, breakfast
+    // 4.46, buddha-fractal 0.0215; 8 -> 0.266, 5.42, 0.0208; 16 -> 0.251, 5.75, 0.0202.
+    double warmup = 16.0;
 };
 
 // Estimated bytes of a hemi field with these parameters (tables, CDFs, points, kd-tree).
@@ -54,6 +59,7 @@ public:
                             const std::function<float(const glm::vec3&)>& fcos) const override;
     float irradianceEstimate(int region, const glm::vec3& n) const override;
     float radiance(int region, const glm::vec3& w) const override;
+    float confidence(int region) const override;
     void beginPass(int numSlots) override;
     void record(int slot, int region, const glm::vec3& w, float target) override;
     void endPass() override;
@@ -120,10 +126,11 @@ private:
     std::unique_ptr<PointKdTree> tree_;
     std::vector<double> q_;          // Q per (region, stratum)
     // Per region, one cache line: the frame of its hemisphere (z = normal) and the moment
-    // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j.
+    // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, and its confidence.
     struct alignas(64) RegionFrame {
         HemiFrame frame;
         glm::vec3 moment{0.f};
+        float confidence = 0.f;  // visits / (visits + warmup * strata), frozen per pass
     };
     std::vector<RegionFrame> frames_;
     std::vector<uint64_t> visits_;   // applied targets per (region, stratum)

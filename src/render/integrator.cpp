@@ -1,5 +1,7 @@
 #include "render/integrator.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -7,8 +9,9 @@
 
 namespace rlpbrt {
 
-Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
-    constexpr float kOrigin = 1.f / 32.f, kFloatScale = 1.f / 65536.f, kIntScale = 256.f;
+Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n, float smallScale) {
+    const float kOrigin = smallScale / 32.f, kFloatScale = smallScale / 65536.f;
+    constexpr float kIntScale = 256.f;
     Vec3 out;
     for (int i = 0; i < 3; ++i) {
         int32_t offset = int32_t(kIntScale * n[i]);
@@ -29,6 +32,9 @@ PathIntegrator::PathIntegrator(const Scene& scene, const GuideSettings& guide)
       guide_(guide), maxDepth_(scene.integrator.maxDepth),
       rrThreshold_(scene.integrator.rrThreshold) {
     guide_.mix = clamp(guide_.mix, 0.f, 1.f);
+    const Vec3 extent = scene.boundsMax() - scene.boundsMin();
+    const float size = std::max({extent.x, extent.y, extent.z});
+    if (std::isfinite(size) && size > 0.f) originScale_ = std::min(1.f, size);
     if (guide_.mix == 0.f && !guide_.learn) guide_.field = nullptr;
 }
 
@@ -72,8 +78,8 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
 
 namespace {
 // Offsets a ray origin to the side of the surface that direction w leaves on.
-Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w) {
-    return offsetRayOrigin(si.p, glm::dot(w, si.ng) > 0.f ? si.ng : -si.ng);
+Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w, float smallScale) {
+    return offsetRayOrigin(si.p, glm::dot(w, si.ng) > 0.f ? si.ng : -si.ng, smallScale);
 }
 
 // A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide).
@@ -99,7 +105,8 @@ float PathIntegrator::directionPdf(const BSDF& bsdf, int region, const Vec3& wo,
                                    const Vec3& wi) const {
     float pb = bsdf.pdf(wo, wi);
     if (region < 0) return pb;
-    return guide_.mix * guide_.field->pdf(region, wi) + (1.f - guide_.mix) * pb;
+    const float mix = regionMix(region);
+    return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * pb : pb;
 }
 
 PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
@@ -119,7 +126,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
-    const float mix = guide_.mix;
+    const float mix = regionMix(region);
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
@@ -155,7 +162,7 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     if (!light.sampleLi(ctx, u, &ls) || !ls.valid()) return Spectrum(0.f);
     Spectrum f = bsdf.f(si.wo, ls.wi) * std::abs(glm::dot(ls.wi, si.ns));
     if (isBlack(f)) return Spectrum(0.f);
-    Vec3 o = spawnOrigin(si, ls.wi);
+    Vec3 o = spawnOrigin(si, ls.wi, originScale_);
     float tMax = std::isinf(ls.dist) ? Infinity : ls.dist * (1.f - 1e-4f);
     ++stats.rays;
     if (scene_.occluded(o, ls.wi, tMax)) return Spectrum(0.f);
@@ -249,7 +256,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (si.material < 0) {
             if (bounces >= maxDepth_ || ++passThroughs > 256) break;
             if (pending.active()) pending.target += pending.weight * emitted;
-            ray.o = spawnOrigin(si, ray.d);
+            ray.o = spawnOrigin(si, ray.d, originScale_);
             --bounces;
             continue;
         }
@@ -317,7 +324,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
         }
         prev = LightSampleContext{si.p, si.ng};
-        ray.o = spawnOrigin(si, ds.wi);
+        ray.o = spawnOrigin(si, ds.wi, originScale_);
         ray.d = ds.wi;
         ray.tMax = Infinity;
         if (!isFinite(beta)) break;

@@ -62,6 +62,11 @@ private:
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                                     Sampler& sampler) const;
     float directionPdf(const BSDF& bsdf, int region, const Vec3& wo, const Vec3& wi) const;
+    // Probability of a guided sample at a region: the mix setting times the region's
+    // confidence (0 without a region).
+    float regionMix(int region) const {
+        return region >= 0 ? guide_.mix * guide_.field->confidence(region) : 0.f;
+    }
     Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                          Sampler& sampler, PathStats& stats) const;
     // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance).
@@ -73,6 +78,7 @@ private:
     GuideSettings guide_;
     int maxDepth_;
     float rrThreshold_;
+    float originScale_ = 1.f;  // smallScale of offsetRayOrigin: min(1, scene size)
 };
 
 // Builds the guiding field of --guide/--guide-param for a scene (null field for "none") and
@@ -83,7 +89,10 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
                   std::string* error);
 
 // Moves p off a surface with unit normal n (oriented towards the side the ray leaves on),
-// by a few float ULPs: robust at any scene scale (Wachter and Binder 2019).
-Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n);
+// by 256 float ULPs of each coordinate (Wachter and Binder 2019); coordinates within
+// smallScale / 32 of zero, where ULPs vanish, move by smallScale / 65536 instead. The
+// integrator passes min(1, scene size) so that offsets stay relative in tiny scenes
+// (a 1e-4-sized scene would otherwise be offset by 15% of its size).
+Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n, float smallScale = 1.f);
 
 }  // namespace rlpbrt

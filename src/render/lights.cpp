@@ -573,18 +573,10 @@ public:
     }
 
 private:
-    static bool isFullSphere(const Quadric& q) {
-        return q.kind == Quadric::Kind::Sphere && q.zMin <= -q.radius && q.zMax >= q.radius &&
-               q.phiMax >= 2 * Pi;
-    }
     // Cone sampling (through quadrics.h) for full spheres seen from outside under a
-    // similarity; the same test quadrics.cpp applies, in double precision.
+    // similarity; the same test quadrics.cpp applies.
     bool useCone(const Vec3& refObj) const {
-        const Quadric& q = shape_->quadric;
-        if (!similar_ || !isFullSphere(q)) return false;
-        glm::dvec3 r(refObj);
-        double rad = q.radius;
-        return glm::dot(r, r) > rad * rad;
+        return similar_ && usesSphereCone(shape_->quadric, refObj);
     }
     // World normal of an object-space unit normal, oriented as pbrt-v3's intersection
     // normal (and scene.cpp's): the object normal cross(dpdu, dpdv) flipped by flipNormals

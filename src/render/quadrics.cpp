@@ -425,11 +425,17 @@ bool sampleArea(const Quadric& q, Vec2 u, QuadricSample* s) {
     return true;
 }
 
+bool usesSphereCone(const Quadric& q, const Vec3& refF) {
+    DVec3 ref(refF);
+    double r = q.radius;
+    return isFullSphere(q) && glm::dot(ref, ref) > r * r * (1 + 1e-4);
+}
+
 bool sampleSolidAngle(const Quadric& q, const Vec3& refF, Vec2 u, QuadricSample* s) {
     DVec3 ref(refF);
     double r = q.radius;
     double dc2 = glm::dot(ref, ref);
-    if (isFullSphere(q) && dc2 > r * r) {
+    if (usesSphereCone(q, refF)) {
         // Uniform direction in the cone subtended by the sphere, mapped to the visible point.
         double dc = std::sqrt(dc2);
         double sin2Max = r * r / dc2;
@@ -472,7 +478,7 @@ float pdfSolidAngle(const Quadric& q, const Vec3& refF, const Vec3& wiF) {
     DVec3 ref(refF), wi(wiF);
     double r = q.radius;
     double dc2 = glm::dot(ref, ref);
-    if (isFullSphere(q) && dc2 > r * r) {
+    if (usesSphereCone(q, refF)) {
         double len = glm::length(wi);
         if (len == 0) return 0;
         double sin2Max = r * r / dc2;

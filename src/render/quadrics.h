@@ -79,8 +79,16 @@ struct QuadricSample {
 // Returns false when the shape cannot be sampled (hyperboloid, zero area).
 bool sampleArea(const Quadric& q, Vec2 u, QuadricSample* s);
 
+// True when sampleSolidAngle/pdfSolidAngle use cone sampling from `ref` (object space): a
+// full sphere and ref outside it by more than a relative 1e-4 of the radius squared. Points on
+// the sphere itself (a path vertex on an emitting sphere, e.g. seen from inside) get area
+// sampling: pbrt-v3 offsets the reference point towards the centre for the same reason; cone
+// sampling from a point on the surface degenerates (measured: -7% radiance inside a closed
+// emitting sphere).
+bool usesSphereCone(const Quadric& q, const Vec3& ref);
+
 // Point on the shape sampled as seen from `ref`, pdf per steradian of the direction
-// ref -> p. Full spheres seen from outside use pbrt-v3's cone sampling (uniform within the
+// ref -> p. Full spheres seen from outside (usesSphereCone) use pbrt-v3's cone sampling (uniform within the
 // cone subtended by the sphere); otherwise the area sample is converted to solid angle.
 // Returns false (pdf 0) when no valid sample exists.
 bool sampleSolidAngle(const Quadric& q, const Vec3& ref, Vec2 u, QuadricSample* s);

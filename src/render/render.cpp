@@ -1,5 +1,7 @@
 #include "render/render.h"
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -49,9 +51,15 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     guiding::GuidingField* field = options.guide.field;
     const int totalSpp = scene.sampler->samplesPerPixel();
     const bool timed = options.timeBudget > 0.0;
-    // Samples per pass: one while the budget is open-ended; otherwise a few passes so that
-    // progress and cancellation stay responsive.
-    const int sppPerPass = 1;
+    // Passes: plain path tracing takes one sample per pixel per pass from one sequence per
+    // pixel. A guided render learns between passes, so each pass draws an independent sample
+    // set (Sampler::passSampler) sized half the samples so far (1, 1, 1, 1, 2, 3, 4, 6, 9,
+    // ...; at most 64): frequent updates early, well-stratified sets later. Measured at 64 spp
+    // (relMSE, hemi): doubling pass sizes gave veach-bidir 0.382 / breakfast 4.73 against
+    // 0.345 / 4.46 with halves; one final set for the last three quarters of the budget,
+    // without learning, gave buddha-fractal 0.0222 against 0.0215.
+    const bool guided = field != nullptr;
+    constexpr int kMaxGuidedPass = 64;
 
     tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers(
         [&] { return scene.sampler->clone(); });
@@ -65,13 +73,26 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     for (const auto& t : tiles) pixelsPerPass += (long long)t.area();
     int pass = 0;
     for (;;) {
-        int first = result.spp;
-        int count = timed ? sppPerPass : std::min(sppPerPass, totalSpp - first);
-        if (!timed && count <= 0) break;
+        int count = guided ? std::clamp(result.spp / 2, 1, kMaxGuidedPass) : 1;
+        if (!timed) {
+            count = std::min(count, totalSpp - result.spp);
+        } else if (pass > 0) {
+            // Only what fits in the budget at the speed so far.
+            const double elapsed = now() - start;
+            const double perSpp = elapsed / result.spp;
+            count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
+        }
+        if (count <= 0) break;
+        // Guided: this pass's own sample set, indices from 0; otherwise the next samples of
+        // the one sequence per pixel.
+        const int first = guided ? 0 : result.spp;
+        std::unique_ptr<Sampler> passProto =
+            guided ? scene.sampler->passSampler(count, pass) : nullptr;
         if (field) field->beginPass(int(tiles.size()));
         arena.execute([&] {
             tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
-                Sampler& sampler = *samplers.local();
+                std::unique_ptr<Sampler> passSampler = passProto ? passProto->clone() : nullptr;
+                Sampler& sampler = passSampler ? *passSampler : *samplers.local();
                 PathStats& st = stats.local();
                 FilmTile& tile = *tileFilms[ti];
                 const Bounds2i& b = tiles[ti];
@@ -110,11 +131,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (options.cancel && options.cancel->load()) {
             result.cancelled = true;
             break;
-        }
-        if (timed) {
-            // Stop when another pass would overrun the budget.
-            double perPass = elapsed / pass;
-            if (elapsed + perPass > options.timeBudget) break;
         }
     }
     if (options.progress) std::fprintf(stderr, "\n");

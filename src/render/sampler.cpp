@@ -1,6 +1,7 @@
 // Pixel samplers and the pbrt-v3 Sampler directive factory.
 #include "render/sampler.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "render/lowdiscrepancy.h"
@@ -22,6 +23,11 @@ inline uint64_t dimHash(uint64_t key, uint32_t dim) {
 // Two seeds for the Owen scrambles of the x and y values of one dimension hash.
 inline uint64_t scrambleSeedX(uint64_t h) { return mixBits(h ^ 0x5851f42d4c957f2dULL); }
 inline uint64_t scrambleSeedY(uint64_t h) { return mixBits(h ^ 0x14057b7ef767814fULL); }
+
+// Seed of a guided render's pass: independent streams per pass.
+inline uint64_t passSeed(uint64_t seed, int pass) {
+    return hashCombine(seed ^ 0x243f6a8885a308d3ULL, uint64_t(uint32_t(pass)));
+}
 
 inline float unitFromDouble(double v) { return std::min(float(v), OneMinusEpsilon); }
 
@@ -46,6 +52,10 @@ Vec2 IndependentSampler::get2D() {
 
 std::unique_ptr<Sampler> IndependentSampler::clone() const {
     return std::make_unique<IndependentSampler>(spp_, seed_);
+}
+
+std::unique_ptr<Sampler> IndependentSampler::passSampler(int setSize, int pass) const {
+    return std::make_unique<IndependentSampler>(std::max(setSize, 1), passSeed(seed_, pass));
 }
 
 // ---- StratifiedSampler -------------------------------------------------------------------
@@ -81,6 +91,13 @@ Vec2 StratifiedSampler::get2D() {
 
 std::unique_ptr<Sampler> StratifiedSampler::clone() const {
     return std::make_unique<StratifiedSampler>(xSamples_, ySamples_, jitter_, seed_);
+}
+
+std::unique_ptr<Sampler> StratifiedSampler::passSampler(int setSize, int pass) const {
+    const int n = std::max(setSize, 1);
+    int xs = int(std::sqrt(double(n)));  // near-square factorization xs * ys == n
+    while (xs > 1 && n % xs != 0) --xs;
+    return std::make_unique<StratifiedSampler>(xs, n / xs, jitter_, passSeed(seed_, pass));
 }
 
 // ---- PaddedSobolSampler ------------------------------------------------------------------
@@ -119,6 +136,11 @@ Vec2 PaddedSobolSampler::getPixel2D() {
 
 std::unique_ptr<Sampler> PaddedSobolSampler::clone() const {
     return std::make_unique<PaddedSobolSampler>(spp_, seed_, pixelCenter_);
+}
+
+std::unique_ptr<Sampler> PaddedSobolSampler::passSampler(int setSize, int pass) const {
+    return std::make_unique<PaddedSobolSampler>(std::max(setSize, 1), passSeed(seed_, pass),
+                                                pixelCenter_);
 }
 
 // ---- Factory -----------------------------------------------------------------------------

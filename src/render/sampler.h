@@ -30,6 +30,13 @@ public:
     virtual Vec2 getPixel2D() = 0;
     // An independent copy with the same configuration (one per thread).
     virtual std::unique_ptr<Sampler> clone() const = 0;
+    // A sampler of the same kind for pass `pass` of a guided render: sets of setSize samples
+    // per pixel whose values are independent of every other pass's (a seed derived from this
+    // sampler's and the pass index). A learned policy depends on earlier passes; if a pass's
+    // samples were stratified against earlier ones (one long sequence per pixel), the samples
+    // would be correlated with the policy and the image biased (measured: +0.5% on a white
+    // furnace with hemi and one Sobol' sequence).
+    virtual std::unique_ptr<Sampler> passSampler(int setSize, int pass) const = 0;
 
 protected:
     explicit Sampler(int spp) : spp_(spp) {}
@@ -47,6 +54,7 @@ public:
     Vec2 get2D() override;
     Vec2 getPixel2D() override { return get2D(); }
     std::unique_ptr<Sampler> clone() const override;
+    std::unique_ptr<Sampler> passSampler(int setSize, int pass) const override;
 
 private:
     uint64_t seed_;
@@ -69,6 +77,7 @@ public:
     Vec2 get2D() override;
     Vec2 getPixel2D() override { return get2D(); }
     std::unique_ptr<Sampler> clone() const override;
+    std::unique_ptr<Sampler> passSampler(int setSize, int pass) const override;
 
 private:
     int xSamples_, ySamples_;
@@ -95,6 +104,7 @@ public:
     Vec2 get2D() override;
     Vec2 getPixel2D() override;
     std::unique_ptr<Sampler> clone() const override;
+    std::unique_ptr<Sampler> passSampler(int setSize, int pass) const override;
 
 private:
     uint64_t seed_;

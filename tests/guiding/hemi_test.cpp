@@ -735,5 +735,33 @@ TEST(HemiField, DeterministicAcrossThreadSchedules) {
     EXPECT_GT(a->stats().records, 0u);
 }
 
+// Confidence = visits / (visits + warmup * strata), frozen at endPass: 0 before any data, 1/2
+// after warmup * strata records, 1 with warmup 0 (the paper's pure mixture), 0 for invalid
+// regions; bad warmup values are refused.
+TEST(HemiField, ConfidenceGrowsWithVisits) {
+    auto f = makeHemi(planeScene(), {{"points", "1"}, {"strata", "4x4"}, {"warmup", "2"}});
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->confidence(0), 0.f);
+    EXPECT_EQ(f->confidence(-1), 0.f);
+    EXPECT_EQ(f->confidence(f->numRegions()), 0.f);
+    f->beginPass(1);
+    for (int i = 0; i < 32; ++i) f->record(0, 0, glm::vec3(0.f, 0.f, 1.f), 1.f);
+    EXPECT_EQ(f->confidence(0), 0.f);  // not before endPass
+    f->endPass();
+    EXPECT_FLOAT_EQ(f->confidence(0), 0.5f);  // 32 / (32 + 2 * 16)
+    EXPECT_EQ(f->confidence(1), 0.f);         // the other hemisphere saw nothing
+    auto pure = makeHemi(planeScene(), {{"points", "1"}, {"warmup", "0"}});
+    ASSERT_TRUE(pure);
+    EXPECT_EQ(pure->confidence(0), 1.f);
+    for (const char* bad : {"-1", "nan", "2e9", "x"}) {
+        GuideConfig c;
+        c.backend = "hemi";
+        c.params = {{"warmup", bad}};
+        std::string error;
+        EXPECT_FALSE(createGuidingField(c, planeScene(), &error)) << bad;
+        EXPECT_NE(error.find("warmup"), std::string::npos) << error;
+    }
+}
+
 }  // namespace
 }  // namespace rlpbrt::guiding

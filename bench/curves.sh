@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Error-versus-time curves per scene and guiding configuration (the speed/accuracy study).
+#   bench/curves.sh SECONDS OUTDIR [scene-id ...]      (default: every manifest scene)
+# Each configuration of a scene renders once for SECONDS with --curve against pbrt-v3's
+# reference, so one run gives relMSE at every pass (the whole ladder of time budgets). The
+# configurations of one scene run at the same time, one thread each, so that they share
+# whatever else the machine is doing; compare them with each other, not across scenes run
+# at different times. Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
+# commas for spaces), default none, hemi, hemi with mix 0.25/0.75, vdb if built in.
+# Writes OUTDIR/<scene>__<config>.{csv,json,exr}; bench/curves_report.py summarises them.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+shared=${SHARED:-$here/../shared}
+bin=${RLPBRT:-$here/build/rlpbrt}
+secs=${1:?usage: $0 SECONDS OUTDIR [scene-id ...]}
+out=${2:?usage: $0 SECONDS OUTDIR [scene-id ...]}
+shift 2
+mkdir -p "$out"
+want=" $* "
+default="none=--guide,none hemi=--guide,hemi hemi-mix0.25=--guide,hemi,--guide-param,mix=0.25 hemi-mix0.75=--guide,hemi,--guide-param,mix=0.75"
+if "$bin" --help 2>/dev/null | grep -q vdb; then default="$default vdb=--guide,vdb"; fi
+configs=${CONFIGS:-$default}
+{
+    echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
+    echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
+    echo "seconds: $secs"
+    echo "configs: $configs"
+    echo "commit: $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+} > "$out/run.txt"
+
+tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media; do
+    [ $# -gt 0 ] && [[ "$want" != *" $id "* ]] && continue
+    pids=()
+    for cfg in $configs; do
+        name=${cfg%%=*}
+        args=${cfg#*=}
+        # shellcheck disable=SC2086
+        "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads 1 --quiet ${args//,/ } \
+            --ref "$shared/references/$id.exr" --curve "$out/${id}__$name.csv" \
+            --stats "$out/${id}__$name.json" -o "$out/${id}__$name.exr" \
+            > /dev/null 2> "$out/${id}__$name.log" &
+        pids+=($!)
+    done
+    for p in "${pids[@]}"; do wait "$p" || echo "warning: a run of $id failed (see $out/${id}__*.log)" >&2; done
+    echo "$id done" >&2
+done

@@ -1,0 +1,320 @@
+// Scenes with a known answer, rendered with every guiding backend and at the extremes of the
+// guide's parameters, the radiance range and the scene scale. Each check compares the mean
+// over a block of pixels whose exact value is known with that value, within 5 standard errors
+// of the mean estimated from the pixels themselves (box filter of radius 0.5, so every sample
+// lands in exactly one pixel and pixels are independent estimates): a correct renderer fails
+// such a check with probability below 1e-6, and the seeds are fixed.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "parser/diagnostics.h"
+#include "render/image.h"
+#include "render/metrics.h"
+#include "render/render.h"
+#include "render/scene.h"
+#include "render/scene_builder.h"
+
+namespace rlpbrt {
+namespace {
+
+struct Rendered {
+    Image image;
+    bool ok = false;
+};
+
+// Renders pbrt-v3 scene text with one backend and its parameters (1 thread, fixed seed).
+Rendered renderText(const std::string& text, const std::string& backend,
+                    const std::map<std::string, std::string>& params = {}, int spp = 64,
+                    uint64_t seed = 1) {
+    Rendered out;
+    char path[] = "/tmp/rlpbrt-analytic-XXXXXX.pbrt";
+    int fd = mkstemps(path, 5);
+    if (fd < 0) return out;
+    ::close(fd);
+    {
+        std::ofstream f(path);
+        f << text;
+    }
+    Diagnostics diag;
+    diag.setStream(nullptr);
+    SceneDesc desc;
+    bool loaded = loadSceneDesc(path, diag, &desc);
+    std::remove(path);
+    if (!loaded) return out;
+    BuildOptions bo;
+    bo.sppOverride = spp;
+    bo.seed = seed;
+    std::unique_ptr<Scene> scene = buildScene(desc, bo, diag);
+    if (!scene || diag.errorCount() > 0) return out;
+    guiding::GuideConfig gc;
+    gc.backend = backend;
+    gc.params = params;
+    std::unique_ptr<guiding::GuidingField> field;
+    RenderOptions ro;
+    std::string err;
+    if (!setupGuiding(*scene, gc, &field, &ro.guide, &err)) {
+        ADD_FAILURE() << err;
+        return out;
+    }
+    ro.nThreads = 1;
+    out.image = render(*scene, ro).image;
+    out.ok = true;
+    return out;
+}
+
+// Mean of the luminance-free average of R, G, B over all pixels, and its standard error.
+struct BlockStats {
+    double mean = 0, stderr_ = 0;
+};
+BlockStats stats(const Image& img) {
+    const int n = img.width * img.height;
+    std::vector<double> v(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const float* p = &img.pixels[size_t(i) * size_t(img.channels)];
+        v[size_t(i)] = (double(p[0]) + double(p[1]) + double(p[2])) / 3.0;
+    }
+    double m = 0;
+    for (double x : v) m += x;
+    m /= n;
+    double var = 0;
+    for (double x : v) var += (x - m) * (x - m);
+    var /= (n - 1);
+    return {m, std::sqrt(var / n)};
+}
+
+// The check every test uses: finite image, and |mean - exact| <= 5 standard errors (plus a
+// relative 1e-5 for float accumulation when the estimate has no variance at all).
+void expectMean(const Rendered& r, double exact, const std::string& what) {
+    ASSERT_TRUE(r.ok) << what;
+    ASSERT_FALSE(hasNonFinite(r.image)) << what;
+    BlockStats s = stats(r.image);
+    EXPECT_NEAR(s.mean, exact, 5.0 * s.stderr_ + 1e-5 * std::abs(exact))
+        << what << ": mean " << s.mean << " +- " << s.stderr_ << ", exact " << exact;
+}
+
+std::string num(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.9g", v);
+    return buf;
+}
+
+// White furnace: a convex matte sphere of albedo rho (radius s) under a uniform environment
+// L fills the whole view, so every pixel is exactly rho * L.
+std::string furnace(double rho, double L, double s = 1.0, const std::string& extra = "") {
+    return "LookAt 0 0 " + num(3 * s) + "  0 0 0  0 1 0\n"
+           "Camera \"perspective\" \"float fov\" 20\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"path\" \"integer maxdepth\" 5\n"
+           "WorldBegin\n"
+           "LightSource \"infinite\" \"rgb L\" [" + num(L) + " " + num(L) + " " + num(L) + "]\n" +
+           extra +
+           "Material \"matte\" \"rgb Kd\" [" + num(rho) + " " + num(rho) + " " + num(rho) + "]\n"
+           "Shape \"sphere\" \"float radius\" " + num(s) + "\n"
+           "WorldEnd\n";
+}
+
+// A closed sphere (radius s) seen from its centre, every point emitting Le (two-sided) with
+// albedo rho: L = Le * sum_{k=0}^{maxdepth} rho^k everywhere. `inside` adds shapes in view.
+std::string enclosure(double rho, double Le, int maxDepth, double s = 1.0,
+                      const std::string& inside = "") {
+    return "LookAt 0 0 0  0 0 -1  0 1 0\n"
+           "Camera \"perspective\" \"float fov\" 60\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"path\" \"integer maxdepth\" " + std::to_string(maxDepth) + "\n"
+           "WorldBegin\n" + inside +
+           "AttributeBegin\n"
+           "AreaLightSource \"diffuse\" \"rgb L\" [" + num(Le) + " " + num(Le) + " " + num(Le) +
+           "] \"bool twosided\" true\n"
+           "Material \"matte\" \"rgb Kd\" [" + num(rho) + " " + num(rho) + " " + num(rho) + "]\n"
+           "Shape \"sphere\" \"float radius\" " + num(s) + "\n"
+           "AttributeEnd\n"
+           "WorldEnd\n";
+}
+
+double series(double rho, double Le, int maxDepth) {
+    double sum = 0, term = Le;
+    for (int k = 0; k <= maxDepth; ++k, term *= rho) sum += term;
+    return sum;
+}
+
+// A large matte disk of albedo rho seen from above under a uniform sky L: rho * L.
+std::string plane(double rho, double L) {
+    return "LookAt 0 0 1  0 0 0  0 1 0\n"
+           "Camera \"perspective\" \"float fov\" 30\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"path\" \"integer maxdepth\" 5\n"
+           "WorldBegin\n"
+           "LightSource \"infinite\" \"rgb L\" [" + num(L) + " " + num(L) + " " + num(L) + "]\n"
+           "Material \"matte\" \"rgb Kd\" [" + num(rho) + " " + num(rho) + " " + num(rho) + "]\n"
+           "Shape \"disk\" \"float radius\" 1000\n"
+           "WorldEnd\n";
+}
+
+const char* kBackends[] = {"none", "hemi"};
+
+class Analytic : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(Analytic, WhiteFurnace) {
+    for (double rho : {0.0, 0.5, 1.0})
+        expectMean(renderText(furnace(rho, 1.0), GetParam()), rho, "furnace rho " + num(rho));
+}
+
+TEST_P(Analytic, ClosedEnclosureGeometricSeries) {
+    expectMean(renderText(enclosure(0.5, 1.0, 5), GetParam()), series(0.5, 1.0, 5),
+               "enclosure maxdepth 5");
+    // Deep paths: Russian roulette keeps the long tail unbiased.
+    expectMean(renderText(enclosure(0.8, 1.0, 60), GetParam(), {}, 128),
+               series(0.8, 1.0, 60), "enclosure maxdepth 60");
+}
+
+TEST_P(Analytic, PlaneUnderConstantSky) {
+    expectMean(renderText(plane(0.7, 2.0), GetParam()), 1.4, "plane");
+}
+
+// Lossless delta BSDFs inside the uniform field of a closed enclosure: a mirror of
+// reflectance 1 and a glass sphere change nothing (with a deep maxdepth so that truncation
+// is below the noise: 0.5^200).
+TEST_P(Analytic, DeltaBsdfsInUniformField) {
+    const std::string inside =
+        "AttributeBegin\nMaterial \"mirror\" \"rgb Kr\" [1 1 1]\n"
+        "Translate -0.3 0 -0.6\nShape \"sphere\" \"float radius\" 0.2\nAttributeEnd\n"
+        "AttributeBegin\nMaterial \"glass\"\n"
+        "Translate 0.3 0 -0.6\nShape \"sphere\" \"float radius\" 0.2\nAttributeEnd\n";
+    expectMean(renderText(enclosure(0.5, 1.0, 200, 1.0, inside), GetParam(), {}, 128), 2.0,
+               "mirror and glass in an enclosure");
+}
+
+// Scene scale from 1e-4 to 1e5: ray offsets must scale (a self-intersection darkens the
+// image, a too-large offset leaks light).
+TEST_P(Analytic, SceneScaleExtremes) {
+    for (double s : {1e-4, 1e5}) {
+        expectMean(renderText(furnace(0.5, 1.0, s), GetParam()), 0.5, "furnace scale " + num(s));
+        expectMean(renderText(enclosure(0.5, 1.0, 5, s), GetParam()), series(0.5, 1.0, 5),
+                   "enclosure scale " + num(s));
+    }
+}
+
+// Radiance from 1e-8 to 1e8.
+TEST_P(Analytic, RadianceExtremes) {
+    for (double L : {1e-8, 1e8}) {
+        expectMean(renderText(furnace(0.5, L), GetParam()), 0.5 * L, "furnace L " + num(L));
+        expectMean(renderText(enclosure(0.5, L, 5), GetParam()), series(0.5, L, 5),
+                   "enclosure Le " + num(L));
+    }
+}
+
+// Degenerate and zero-area triangles and a flipped sphere in the furnace: nothing changes
+// (degenerate triangles have no area to hit; matte ignores the normal's orientation).
+TEST_P(Analytic, DegenerateGeometryAndFlippedNormals) {
+    const std::string degenerate =
+        "AttributeBegin\nMaterial \"matte\"\n"
+        "Shape \"trianglemesh\" \"integer indices\" [0 1 2 3 4 5]"
+        " \"point P\" [0 0 1.5  0 0 1.5  0 0 1.5   -1 0 1.5  0 0 1.5  1 0 1.5]\n"
+        "AttributeEnd\n";
+    expectMean(renderText(furnace(0.5, 1.0, 1.0, degenerate), GetParam()), 0.5,
+               "furnace with degenerate triangles");
+    expectMean(renderText(furnace(0.5, 1.0, 1.0, "ReverseOrientation\n"), GetParam()), 0.5,
+               "furnace with a flipped sphere");
+}
+
+// No light at all: exactly black, and the guide learns only zeros without trouble.
+TEST_P(Analytic, AllBlackScene) {
+    std::string text = enclosure(0.5, 0.0, 5);
+    Rendered r = renderText(text, GetParam());
+    ASSERT_TRUE(r.ok);
+    ASSERT_FALSE(hasNonFinite(r.image));
+    for (float v : r.image.pixels) ASSERT_EQ(v, 0.f);
+}
+
+// A closed box lit only through a small hole by a tiny, very bright light: almost every path
+// carries zero. The image must be finite and non-negative, with some light inside.
+TEST_P(Analytic, SmallHoleTinyBrightLight) {
+    // Box [-1,1]^3 made of 6 quads, the +z face with a hole: built from 4 quads around it.
+    const std::string text =
+        "LookAt 0 0 0.9  0 0 -1  0 1 0\n"
+        "Camera \"perspective\" \"float fov\" 90\n"
+        "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+        "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+        "Sampler \"sobol\" \"integer pixelsamples\" 32\n"
+        "Integrator \"path\" \"integer maxdepth\" 8\n"
+        "WorldBegin\n"
+        "AttributeBegin\nTranslate 0 0 3\n"
+        "AreaLightSource \"diffuse\" \"rgb L\" [1e9 1e9 1e9]\n"
+        "Shape \"sphere\" \"float radius\" 0.001\nAttributeEnd\n"
+        "Material \"matte\" \"rgb Kd\" [0.8 0.8 0.8]\n"
+        "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3  4 6 5 4 7 6  0 4 5 0 5 1  "
+        "1 5 6 1 6 2  2 6 7 2 7 3  3 7 4 3 4 0]\n"
+        "  \"point P\" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1]\n"
+        "WorldEnd\n";
+    // The top face (4 5 6 7 at z = 1) is replaced by a frame with a 0.02-wide hole.
+    std::string withHole = text;
+    const std::string top = "4 6 5 4 7 6  ";
+    withHole.replace(withHole.find(top), top.size(), "");
+    withHole.replace(withHole.find("WorldEnd"), 8,
+                     "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3  4 5 6 4 6 7  "
+                     "8 9 10 8 10 11  12 13 14 12 14 15]\n"
+                     "  \"point P\" [-1 -1 1  1 -1 1  1 -0.01 1  -1 -0.01 1   "
+                     "-1 0.01 1  1 0.01 1  1 1 1  -1 1 1   "
+                     "-1 -0.01 1  -0.01 -0.01 1  -0.01 0.01 1  -1 0.01 1   "
+                     "0.01 -0.01 1  1 -0.01 1  1 0.01 1  0.01 0.01 1]\nWorldEnd");
+    Rendered r = renderText(withHole, GetParam(), {}, 32);
+    ASSERT_TRUE(r.ok);
+    ASSERT_FALSE(hasNonFinite(r.image));
+    double sum = 0;
+    for (float v : r.image.pixels) {
+        ASSERT_GE(v, 0.f);
+        sum += v;
+    }
+    EXPECT_GT(sum, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, Analytic, ::testing::ValuesIn(kBackends));
+
+// The guide's parameters at their extremes: the furnace and enclosure answers do not move.
+struct Extreme {
+    const char* name;
+    std::map<std::string, std::string> params;
+};
+class GuideExtremes : public ::testing::TestWithParam<Extreme> {};
+
+TEST_P(GuideExtremes, ExactMeansAndFiniteImages) {
+    const Extreme& e = GetParam();
+    expectMean(renderText(furnace(0.5, 1.0), "hemi", e.params), 0.5, std::string(e.name));
+    expectMean(renderText(enclosure(0.5, 1.0, 5), "hemi", e.params), series(0.5, 1.0, 5),
+               std::string(e.name));
+}
+
+const Extreme kExtremes[] = {
+    {"alpha_1e_9", {{"alpha", "1e-9"}}},
+    {"alpha_1", {{"alpha", "1"}}},
+    {"init_1e_30", {{"init", "1e-30"}}},
+    {"init_1e30", {{"init", "1e30"}}},
+    {"strata_1x1", {{"strata", "1x1"}}},
+    {"strata_64x64", {{"strata", "64x64"}, {"points", "256"}}},
+    {"points_1", {{"points", "1"}}},
+    {"points_200000", {{"points", "200000"}, {"strata", "2x2"}}},
+    {"mix_1_pure_policy", {{"mix", "1"}, {"warmup", "0"}}},
+    {"mix_0", {{"mix", "0"}}},
+    {"epsilon_0", {{"epsilon", "0"}, {"mix", "1"}, {"warmup", "0"}}},
+    {"normal_angle_tiny", {{"normal-angle", "0.001"}}},
+    {"target_sample", {{"target", "sample"}}},
+    {"knn_1", {{"knn", "1"}}},
+};
+
+INSTANTIATE_TEST_SUITE_P(Hemi, GuideExtremes, ::testing::ValuesIn(kExtremes),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace rlpbrt
