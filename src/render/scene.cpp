@@ -532,18 +532,16 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
     {
         const std::string& in = s.integrator.name;
         bool mediaIntegrator = in == "volpath" || in == "bdpt" || in == "mlt";
-        if (!desc.media.empty() && !mediaIntegrator) {
+        // Media are made (and their errors reported) whatever the integrator.
+        for (size_t i = 0; i < desc.media.size(); ++i) {
+            std::unique_ptr<Medium> m = createMedium(desc.media[i], diag);
+            if (!m || !mediaIntegrator) continue;
+            mediumIndex[i] = int(s.media.size());
+            s.media.push_back(std::move(m));
+        }
+        if (!desc.media.empty() && !mediaIntegrator)
             diag.warning(desc.media[0].loc, "integrator \"" + in + "\" ignores participating "
                                             "media (as in pbrt-v3); use \"volpath\" to render them");
-            for (const auto& m : desc.media) m.params.markAllUsed();
-        } else {
-            for (size_t i = 0; i < desc.media.size(); ++i) {
-                std::unique_ptr<Medium> m = createMedium(desc.media[i], diag);
-                if (!m) continue;
-                mediumIndex[i] = int(s.media.size());
-                s.media.push_back(std::move(m));
-            }
-        }
     }
     auto mediumByName = [&](const std::string& name) {
         if (name.empty()) return -1;
