@@ -94,14 +94,55 @@ bool DensityMediumBase::clip(const Vec3& o, const Vec3& d, float tMax, Vec3* oL,
     return true;
 }
 
+void DensityMediumBase::initMajorants(const glm::ivec3& res) {
+    res_ = glm::max(res, glm::ivec3(1));
+    cellSize_ = (boxMax_ - boxMin_) / Vec3(res_);
+    majorants_.assign(size_t(res_.x) * size_t(res_.y) * size_t(res_.z), 0.f);
+    maxDensity_ = 0.f;
+}
+
+void DensityMediumBase::addMajorant(const Vec3& lo, const Vec3& hi, float v) {
+    if (!(v > 0.f)) return;
+    glm::ivec3 a, b;
+    for (int i = 0; i < 3; ++i) {
+        // Conservative cell range (a little slack for rounding at cell borders).
+        float fa = (lo[i] - boxMin_[i]) / cellSize_[i], fb = (hi[i] - boxMin_[i]) / cellSize_[i];
+        a[i] = clamp(int(std::floor(fa - 1e-3f)), 0, res_[i] - 1);
+        b[i] = clamp(int(std::floor(fb + 1e-3f)), 0, res_[i] - 1);
+        if (fb < 0.f || fa > float(res_[i])) return;
+    }
+    for (int z = a.z; z <= b.z; ++z)
+        for (int y = a.y; y <= b.y; ++y)
+            for (int x = a.x; x <= b.x; ++x) {
+                float& m = majorants_[(size_t(z) * size_t(res_.y) + size_t(y)) * size_t(res_.x) +
+                                      size_t(x)];
+                m = std::max(m, v);
+            }
+    maxDensity_ = std::max(maxDensity_, v);
+}
+
+void DensityMediumBase::finishMajorants() {
+    maxDensity_ = 0.f;
+    for (float m : majorants_) maxDensity_ = std::max(maxDensity_, m);
+}
+
 GridMedium::GridMedium(const Spectrum& sigmaA, const Spectrum& sigmaS, float g,
                        const Mat4& worldFromLocal, int nx, int ny, int nz,
                        std::vector<float> density)
     : DensityMediumT<GridMedium>(sigmaA, sigmaS, g, worldFromLocal, Vec3(0.f), Vec3(1.f)),
       nx_(nx), ny_(ny), nz_(nz), density_(std::move(density)) {
-    float m = 0.f;
-    for (float v : density_) m = std::max(m, v);
-    setMaxDensity(m);
+    // About 4 samples per majorant cell along each axis. Sample (i, j, k) is seen by the
+    // trilinear filter within one sample spacing of its position (i + 0.5) / n.
+    auto cells = [](int n) { return std::min(64, (n + 3) / 4); };
+    initMajorants(glm::ivec3(cells(nx), cells(ny), cells(nz)));
+    Vec3 inv(1.f / float(nx), 1.f / float(ny), 1.f / float(nz));
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                Vec3 c = (Vec3(float(i), float(j), float(k)) + 0.5f) * inv;
+                addMajorant(c - inv, c + inv, D(i, j, k));
+            }
+    finishMajorants();
 }
 
 // ------------------------------------------------------------------------------------------

@@ -90,7 +90,9 @@ private:
 };
 
 // A medium whose extinction is sigma_t * density(p) inside a box of its local space (zero
-// outside), tracked against sigma_t * maxDensity. Subclasses supply density() through
+// outside). Free flights and transmittance are tracked cell by cell through a coarse grid
+// of majorants over the box (3D DDA): each cell bounds the density anywhere in it, so
+// empty and thin regions cost few null collisions. Subclasses supply the density through
 // DensityMediumT (static dispatch: the trackers are the hot loop): Derived::densityLookup()
 // returns a callable float(const Vec3& pLocal), made once per tracking call.
 class DensityMediumBase : public Medium {
@@ -100,67 +102,124 @@ public:
                       const Mat4& worldFromLocal, const Vec3& boxMin, const Vec3& boxMax);
     float maxDensity() const { return maxDensity_; }
     float sigmaT() const { return sigmaT_; }
+    // The majorant grid: resolution and the bound of one cell.
+    glm::ivec3 majorantResolution() const { return res_; }
+    float majorant(int x, int y, int z) const {
+        return majorants_[(size_t(z) * size_t(res_.y) + size_t(y)) * size_t(res_.x) + size_t(x)];
+    }
 
 protected:
     // The parametric range [*t0, *t1] of o + t d (world) inside the box, clipped to
     // [0, tMax]; also returns the local-space ray. False when the ray misses it.
     bool clip(const Vec3& o, const Vec3& d, float tMax, Vec3* oL, Vec3* dL, float* t0,
               float* t1) const;
-    void setMaxDensity(float m) {
-        maxDensity_ = m;
-        invMajorant_ = m > 0.f && sigmaT_ > 0.f ? 1.f / (m * sigmaT_) : 0.f;
-    }
+    // Majorant grid set-up: a resolution, then every density value v that can be seen in
+    // the local box [lo, hi] (its filter support), then finish().
+    void initMajorants(const glm::ivec3& res);
+    void addMajorant(const Vec3& lo, const Vec3& hi, float v);
+    void finishMajorants();
+    // Calls f(tA, tB, majorant density) for the cells along oL + t dL, t in [t0, t1], in
+    // order, until f returns false.
+    template <typename F>
+    void traverse(const Vec3& oL, const Vec3& dL, float t0, float t1, F&& f) const;
 
     Spectrum sigmaS_;
     float sigmaT_ = 0.f;
     Mat4 localFromWorld_{1.f};
     Vec3 boxMin_{0.f}, boxMax_{1.f};
     float maxDensity_ = 0.f;
-    float invMajorant_ = 0.f;  // 1 / (sigma_t * maxDensity); 0 = no extinction anywhere
+    glm::ivec3 res_{1, 1, 1};
+    Vec3 cellSize_{1.f};
+    std::vector<float> majorants_{0.f};
 };
+
+template <typename F>
+void DensityMediumBase::traverse(const Vec3& oL, const Vec3& dL, float t0, float t1,
+                                 F&& f) const {
+    Vec3 p = oL + t0 * dL;
+    glm::ivec3 cell, step;
+    Vec3 tNext, tDelta;
+    for (int a = 0; a < 3; ++a) {
+        int c = int(std::floor((p[a] - boxMin_[a]) / cellSize_[a]));
+        cell[a] = clamp(c, 0, res_[a] - 1);
+        if (dL[a] == 0.f) {
+            step[a] = 0;
+            tNext[a] = Infinity;
+            tDelta[a] = Infinity;
+        } else {
+            step[a] = dL[a] > 0.f ? 1 : -1;
+            float edge = boxMin_[a] + float(cell[a] + (dL[a] > 0.f ? 1 : 0)) * cellSize_[a];
+            tNext[a] = (edge - oL[a]) / dL[a];
+            tDelta[a] = cellSize_[a] / std::abs(dL[a]);
+        }
+    }
+    float t = t0;
+    for (;;) {
+        int a = tNext.x < tNext.y ? (tNext.x < tNext.z ? 0 : 2) : (tNext.y < tNext.z ? 1 : 2);
+        float tEnd = std::min(tNext[a], t1);
+        if (tEnd > t && !f(t, tEnd, majorant(cell.x, cell.y, cell.z))) return;
+        t = std::max(t, tEnd);
+        if (tEnd >= t1) return;
+        cell[a] += step[a];
+        if (cell[a] < 0 || cell[a] >= res_[a]) return;
+        tNext[a] += tDelta[a];
+    }
+}
 
 template <typename Derived>
 class DensityMediumT : public DensityMediumBase {
 public:
     using DensityMediumBase::DensityMediumBase;
 
-    // Delta tracking (pbrt-v3 GridDensityMedium::Sample).
+    // Delta tracking (pbrt-v3 GridDensityMedium::Sample, with a majorant per cell).
     MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const override {
         MediumSample ms;
         Vec3 oL, dL;
-        float t, t1;
-        if (invMajorant_ == 0.f || !clip(o, d, tMax, &oL, &dL, &t, &t1)) return ms;
-        const float invMax = 1.f / maxDensity_;
+        float t0, t1;
+        if (maxDensity_ <= 0.f || sigmaT_ <= 0.f || !clip(o, d, tMax, &oL, &dL, &t0, &t1))
+            return ms;
         auto density = static_cast<const Derived&>(*this).densityLookup();
-        for (;;) {
-            t -= std::log(1.f - rng.uniform()) * invMajorant_;
-            if (t >= t1) return ms;
-            if (density(oL + t * dL) * invMax > rng.uniform()) {
-                ms.scattered = true;
-                ms.t = t;
-                ms.weight = sigmaS_ / sigmaT_;
-                return ms;
+        traverse(oL, dL, t0, t1, [&](float tA, float tB, float maj) {
+            if (maj <= 0.f) return true;
+            const float invMajorant = 1.f / (sigmaT_ * maj), invMax = 1.f / maj;
+            for (float t = tA;;) {
+                t -= std::log(1.f - rng.uniform()) * invMajorant;
+                if (t >= tB) return true;
+                if (density(oL + t * dL) * invMax > rng.uniform()) {
+                    ms.scattered = true;
+                    ms.t = t;
+                    ms.weight = sigmaS_ / sigmaT_;
+                    return false;
+                }
             }
-        }
+        });
+        return ms;
     }
     // Ratio tracking with pbrt-v3's Russian roulette below 0.1.
     Spectrum tr(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const override {
         Vec3 oL, dL;
-        float t, t1;
-        if (invMajorant_ == 0.f || !clip(o, d, tMax, &oL, &dL, &t, &t1)) return Spectrum(1.f);
-        const float invMax = 1.f / maxDensity_;
+        float t0, t1;
+        if (maxDensity_ <= 0.f || sigmaT_ <= 0.f || !clip(o, d, tMax, &oL, &dL, &t0, &t1))
+            return Spectrum(1.f);
         auto density = static_cast<const Derived&>(*this).densityLookup();
         float T = 1.f;
-        for (;;) {
-            t -= std::log(1.f - rng.uniform()) * invMajorant_;
-            if (t >= t1) break;
-            T *= 1.f - std::max(0.f, density(oL + t * dL) * invMax);
-            if (T < 0.1f) {
-                float q = std::max(0.05f, 1.f - T);
-                if (rng.uniform() < q) return Spectrum(0.f);
-                T /= 1.f - q;
+        traverse(oL, dL, t0, t1, [&](float tA, float tB, float maj) {
+            if (maj <= 0.f) return true;
+            const float invMajorant = 1.f / (sigmaT_ * maj), invMax = 1.f / maj;
+            for (float t = tA;;) {
+                t -= std::log(1.f - rng.uniform()) * invMajorant;
+                if (t >= tB) return true;
+                T *= 1.f - std::max(0.f, density(oL + t * dL) * invMax);
+                if (T < 0.1f) {
+                    float q = std::max(0.05f, 1.f - T);
+                    if (rng.uniform() < q) {
+                        T = 0.f;
+                        return false;
+                    }
+                    T /= 1.f - q;
+                }
             }
-        }
+        });
         return Spectrum(T);
     }
 };

@@ -8,8 +8,9 @@
 // The grid's own index-to-world transform (which must be linear) places it in the medium's
 // space, then the CTM at MakeNamedMedium places that in the world. Densities are
 // trilinear between voxel centres (openvdb::tools::BoxSampler), the background outside
-// the active voxels. The majorant is the largest active value (voxels and tiles) or the
-// background, whichever is larger.
+// the active voxels (a non-zero background is not extended beyond them). Majorants: a
+// coarse grid (about 8 voxels per cell) of the largest active value (voxels and tiles)
+// within the trilinear filter's reach of each cell.
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
@@ -25,10 +26,22 @@ class VdbMedium final : public DensityMediumT<VdbMedium> {
 public:
     VdbMedium(const Spectrum& sigmaA, const Spectrum& sigmaS, float g, const Mat4& worldFromIndex,
               const Vec3& boxMin, const Vec3& boxMax, openvdb::FloatGrid::ConstPtr grid,
-              float maxDensity)
+              const openvdb::CoordBBox& bbox)
         : DensityMediumT<VdbMedium>(sigmaA, sigmaS, g, worldFromIndex, boxMin, boxMax),
           grid_(std::move(grid)) {
-        setMaxDensity(maxDensity);
+        // About 8 voxels per majorant cell along each axis (at most 64 cells). An active
+        // value (voxel or tile) is seen by the trilinear filter within one voxel of it.
+        openvdb::Coord dim = bbox.dim();
+        auto cells = [](int n) { return std::max(1, std::min(64, (n + 7) / 8)); };
+        initMajorants(glm::ivec3(cells(dim.x() + 2), cells(dim.y() + 2), cells(dim.z() + 2)));
+        for (auto it = grid_->cbeginValueOn(); it; ++it) {
+            openvdb::CoordBBox b;
+            it.getBoundingBox(b);
+            Vec3 lo(float(b.min().x() - 1), float(b.min().y() - 1), float(b.min().z() - 1));
+            Vec3 hi(float(b.max().x() + 1), float(b.max().y() + 1), float(b.max().z() + 1));
+            addMajorant(lo, hi, *it);
+        }
+        finishMajorants();
     }
 
     // One lookup object per tracking call: an unregistered accessor caches the tree path
@@ -93,12 +106,8 @@ std::unique_ptr<Medium> createVdbMedium(const MediumEntity& e, const Spectrum& s
     Mat4 mediumFromIndex;
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j) mediumFromIndex[i][j] = float(m(i, j));  // row vectors
-    float maxDensity = std::max(0.f, grid->background());
     float minDensity = 0.f;
-    for (auto it = grid->cbeginValueOn(); it; ++it) {
-        maxDensity = std::max(maxDensity, *it);
-        minDensity = std::min(minDensity, *it);
-    }
+    for (auto it = grid->cbeginValueOn(); it; ++it) minDensity = std::min(minDensity, *it);
     if (minDensity < 0.f)
         diag.warning(fileLoc, name + ": negative densities read as 0");
     if (grid->background() != 0.f)
@@ -110,12 +119,10 @@ std::unique_ptr<Medium> createVdbMedium(const MediumEntity& e, const Spectrum& s
         // Trilinear filtering reaches one voxel beyond the active voxels.
         lo = Vec3(float(bbox.min().x() - 1), float(bbox.min().y() - 1), float(bbox.min().z() - 1));
         hi = Vec3(float(bbox.max().x() + 1), float(bbox.max().y() + 1), float(bbox.max().z() + 1));
-    } else {
-        maxDensity = 0.f;
     }
     Mat4 worldFromIndex = e.worldFromMedium * mediumFromIndex;
     return std::make_unique<VdbMedium>(sigmaA, sigmaS, g, worldFromIndex, lo, hi,
-                                       openvdb::FloatGrid::ConstPtr(grid), maxDensity);
+                                       openvdb::FloatGrid::ConstPtr(grid), bbox);
 }
 
 }  // namespace rlpbrt
