@@ -221,6 +221,22 @@ INSTANTIATE_TEST_SUITE_P(Segments, GridTracking,
                                            TrackCase{"StartsInside", 0.6f, 10.f}),
                          [](const auto& info) { return std::string(info.param.name); });
 
+TEST(GridMedium, MajorantGridBoundsTheDensity) {
+    // Random sparse data: every point of a majorant cell has density <= the cell's bound.
+    const int nx = 13, ny = 9, nz = 6;
+    Rng rng(99);
+    std::vector<float> d(size_t(nx * ny * nz));
+    for (float& v : d) v = rng.uniform() < 0.2f ? 3.f * rng.uniform() : 0.f;
+    GridMedium m(Spectrum(1.f), Spectrum(1.f), 0.f, Mat4(1.f), nx, ny, nz, d);
+    glm::ivec3 res = m.majorantResolution();
+    EXPECT_EQ(res, glm::ivec3(4, 3, 2));
+    for (int i = 0; i < 200000; ++i) {
+        Vec3 p(rng.uniform(), rng.uniform(), rng.uniform());
+        glm::ivec3 c = glm::min(glm::ivec3(p * Vec3(res)), res - 1);
+        ASSERT_LE(m.density(p), m.majorant(c.x, c.y, c.z) + 1e-6f) << p.x << " " << p.y << " " << p.z;
+    }
+}
+
 TEST(GridMedium, RayMissingTheBoxIsUnattenuated) {
     GridMedium m(Spectrum(1.f), Spectrum(1.f), 0.f, Mat4(1.f), 1, 1, 1, {1.f});
     Rng rng(3);
@@ -388,6 +404,73 @@ TEST(VdbMedium, ConstantBlockTransmittance) {
     EXPECT_NEAR(tr.mean(), expected, 4.5 * tr.stderror() + 1e-6);
     // Outside the active voxels (beyond the one-voxel filter margin): no extinction.
     EXPECT_EQ(scene->media[0]->tr(Vec3(3.f, 5.f, 0.45f), Vec3(1, 0, 0), 2.f, rng), Spectrum(1.f));
+}
+
+TEST(VdbMedium, SameMediumAsTheEquivalentHeterogeneousGrid) {
+    // docs/MEDIA.md's recipe: voxel i holds sample i, the transform scales by (p1 - p0) / n
+    // and translates to p0 + 0.5 (p1 - p0) / n. Both media must then have the same
+    // transmittance along any ray (compared through ratio-tracking means).
+    const int nx = 6, ny = 5, nz = 4;
+    const Vec3 p0(-1.f, 0.f, 0.f), p1(1.f, 1.f, 2.f);
+    Rng rng(17);
+    std::vector<float> d(size_t(nx * ny * nz));
+    // The outer samples are 0: the grid medium ends at [p0, p1] (half a cell beyond its
+    // outer samples) while the vdb field goes on to a whole voxel beyond its active voxels.
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                bool inner = i > 0 && j > 0 && k > 0 && i < nx - 1 && j < ny - 1 && k < nz - 1;
+                float u = rng.uniform(), v = rng.uniform();
+                d[size_t((k * ny + j) * nx + i)] = inner && u < 0.8f ? 2.f * v : 0.f;
+            }
+    openvdb::initialize();
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.f);
+    grid->setName("density");
+    Vec3 s = (p1 - p0) / Vec3(float(nx), float(ny), float(nz)), t = p0 + 0.5f * s;
+    openvdb::math::Mat4d m(double(s.x), 0., 0., 0., 0., double(s.y), 0., 0., 0., 0., double(s.z),
+                           0., double(t.x), double(t.y), double(t.z), 1.);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(m));
+    auto acc = grid->getAccessor();
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                if (float v = d[size_t((k * ny + j) * nx + i)]; v != 0.f)
+                    acc.setValue(openvdb::Coord(i, j, k), v);
+    std::string vdb = (std::filesystem::temp_directory_path() / "rlpbrt_media_equiv.vdb").string();
+    {
+        openvdb::io::File file(vdb);
+        file.write(openvdb::GridPtrVec{grid});
+        file.close();
+    }
+    std::string density;
+    for (float v : d) density += std::to_string(v) + " ";
+    std::string path = writeTemp(
+        "rlpbrt_media_equiv.pbrt",
+        "Integrator \"volpath\"\nRotate 30 0 1 1\n"
+        "MakeNamedMedium \"a\" \"string type\" \"heterogeneous\" \"integer nx\" 6 "
+        "\"integer ny\" 5 \"integer nz\" 4 \"point p0\" [-1 0 0] \"point p1\" [1 1 2] "
+        "\"float density\" [" + density + "] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [1 1 1]\n"
+        "MakeNamedMedium \"b\" \"string type\" \"vdbvolume\" \"string filename\" \"" + vdb +
+        "\" \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [1 1 1]\nWorldBegin\n"
+        "LightSource \"point\" \"rgb I\" [1 1 1]\nWorldEnd\n");
+    Diagnostics diag;
+    std::ostringstream out;
+    diag.setStream(&out);
+    std::unique_ptr<Scene> scene = buildFrom(path, diag);
+    ASSERT_NE(scene, nullptr) << out.str();
+    ASSERT_EQ(scene->media.size(), 2u);
+    for (int r = 0; r < 6; ++r) {
+        Vec3 o(4.f * rng.uniform() - 2.f, 4.f * rng.uniform() - 2.f, -3.f);
+        Vec3 target(rng.uniform() - 0.5f, rng.uniform(), 2.f * rng.uniform());
+        Vec3 dir = glm::normalize(target - o);
+        MeanVar a, b;
+        for (int i = 0; i < 40000; ++i) {
+            a.add(scene->media[0]->tr(o, dir, 10.f, rng)[0]);
+            b.add(scene->media[1]->tr(o, dir, 10.f, rng)[0]);
+        }
+        double se = std::hypot(a.stderror(), b.stderror());
+        EXPECT_NEAR(a.mean(), b.mean(), 5.0 * se + 1e-6) << "ray " << r;
+    }
 }
 
 TEST(VdbMedium, MissingGridIsLocatedError) {
