@@ -338,7 +338,9 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         // Medium boundaries without a surface: continue the ray unchanged.
         if (si.material < 0) {
-            if (bounces >= maxDepth_ || ++passThroughs > 256) break;
+            // (With media, as volpath, light found through boundaries after the last vertex
+            // still counts; path's shadow rays stop at them.)
+            if ((bounces >= maxDepth_ && !media) || ++passThroughs > 256) break;
             if (pending.active()) pending.target += pending.weight * emitted;
             if (media) pm.medium = si.mediumAfter(ray.d, pm.medium);
             ray.o = spawnOrigin(si, ray.d);
