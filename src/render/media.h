@@ -2,7 +2,7 @@
 // `homogeneous` (closed-form free flights and transmittance, one RGB channel chosen per
 // flight with the single-sample spectral MIS pdf of pbrt-v3), `heterogeneous` (pbrt-v3's
 // inline density grid: delta tracking for free flights, ratio tracking for transmittance,
-// against a majorant), and rlpbrt's `vdbvolume` (the same trackers over an OpenVDB grid,
+// against per-cell majorants), and rlpbrt's `vdbvolume` (the same trackers over an OpenVDB grid,
 // media_vdb.cpp). createMedium holds the family's only name switch.
 //
 // All distances are along unit world-space directions. The integrator keeps one Rng per
