@@ -35,7 +35,7 @@ render)
     echo "| scene | rlpbrt 64 spp (s) | pbrt-v3 64 spp (s) | speed-up |"
     echo "|---|---:|---:|---:|"
     tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media; do
-        [ "$media" = "1" ] && continue
+        [ "$media" = "1" ] && [ "${MEDIA:-1}" = "0" ] && continue  # MEDIA=0: surface scenes only
         t=$(for i in $(seq "$repeat"); do wall "$bin" "$shared/scenes/$scene" --spp 64 --nthreads 2 -o "$tmp/o.exr" --quiet; done | median)
         printf '| %s | %.2f | %.2f | %.2fx |\n' "$id" "$t" "$s64" "$(echo "$s64 / $t" | bc -l)"
     done

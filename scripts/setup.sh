@@ -6,7 +6,7 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$here/build}
 
 pkgs=(build-essential cmake ninja-build pkg-config
-      libembree-dev libopenimageio-dev libopenexr-dev libopenvdb-dev libglm-dev libtbb-dev
+      libembree-dev libopenimageio-dev libopenexr-dev libimath-dev libopenvdb-dev libglm-dev libtbb-dev
       libboost-iostreams-dev openimageio-tools libopencv-core-dev
       libcli11-dev libfmt-dev nlohmann-json3-dev libnanoflann-dev libgtest-dev libgmock-dev libbenchmark-dev)
 missing=()

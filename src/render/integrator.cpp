@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "render/media.h"
 #include "render/sampling.h"
 
 namespace rlpbrt {
@@ -150,7 +151,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
 }
 
 Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                     Sampler& sampler, PathStats& stats) const {
+                                     Sampler& sampler, PathStats& stats,
+                                     const PathMedium* media) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
     float pmf;
@@ -164,12 +166,58 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     if (isBlack(f)) return Spectrum(0.f);
     Vec3 o = spawnOrigin(si, ls.wi, originScale_);
     float tMax = std::isinf(ls.dist) ? Infinity : ls.dist * (1.f - 1e-4f);
-    ++stats.rays;
-    if (scene_.occluded(o, ls.wi, tMax)) return Spectrum(0.f);
+    if (media) {
+        f *= transmittance(o, ls.wi, tMax, si.mediumAfter(ls.wi, media->medium), *media->rng,
+                           stats);
+        if (isBlack(f)) return Spectrum(0.f);
+    } else {
+        ++stats.rays;
+        if (scene_.occluded(o, ls.wi, tMax)) return Spectrum(0.f);
+    }
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
     float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, si.wo, ls.wi));
     return f * ls.L * (w / lightPdf);
+}
+
+Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
+                                       PathStats& stats) const {
+    Spectrum tr(1.f);
+    for (int crossings = 0; crossings < 256; ++crossings) {
+        SurfaceInteraction si;
+        ++stats.rays;
+        bool hit = scene_.intersect(Ray(o, d, tMax), &si);
+        if (hit && si.material >= 0) return Spectrum(0.f);
+        if (medium >= 0) tr *= scene_.media[size_t(medium)]->tr(o, d, hit ? si.t : tMax, rng);
+        if (!hit || isBlack(tr)) return tr;
+        medium = si.mediumAfter(d, medium);
+        o = spawnOrigin(si, d, originScale_);
+        tMax -= si.t;
+        if (!(tMax > 0.f)) return tr;
+    }
+    return tr;
+}
+
+Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g,
+                                           const PathMedium& pm, Sampler& sampler,
+                                           PathStats& stats) const {
+    float uLight = sampler.get1D();
+    Vec2 u = sampler.get2D();
+    float pmf;
+    int li = lights_->sample(p, uLight, &pmf);
+    if (li < 0 || pmf == 0.f) return Spectrum(0.f);
+    const Light& light = *scene_.lights[size_t(li)];
+    LightSample ls;
+    if (!light.sampleLi(LightSampleContext{p, Vec3(0.f)}, u, &ls) || !ls.valid())
+        return Spectrum(0.f);
+    float phase = henyeyGreenstein(glm::dot(wo, ls.wi), g);
+    float tMax = std::isinf(ls.dist) ? Infinity : ls.dist * (1.f - 1e-4f);
+    Spectrum tr = transmittance(p, ls.wi, tMax, pm.medium, *pm.rng, stats);
+    if (isBlack(tr)) return Spectrum(0.f);
+    if (ls.isDelta) return phase * tr * ls.L / (pmf * ls.pdf);
+    float lightPdf = pmf * ls.pdf;
+    float w = powerHeuristic(1, lightPdf, 1, phase);
+    return phase * tr * ls.L * (w / lightPdf);
 }
 
 float PathIntegrator::scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
@@ -207,6 +255,20 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     guiding::GuidingField* field = guide_.field;
     const bool learn = field && guide_.learn;
     PendingRecord pending;
+    // Media (volpath): the medium the ray travels in; tracking decisions use a per-path
+    // generator seeded from two sampler dimensions. Scenes without media skip all of it.
+    const bool media = scene_.hasMedia();
+    Rng rng;
+    PathMedium pm;
+    if (media) {
+        uint32_t a, b;
+        float ua = sampler.get1D(), ub = sampler.get1D();
+        std::memcpy(&a, &ua, 4);
+        std::memcpy(&b, &ub, 4);
+        rng.setSeed((uint64_t(a) << 32) | b, uint64_t(slot));
+        pm.medium = scene_.cameraMedium;
+        pm.rng = &rng;
+    }
     auto flush = [&](float addTarget) {
         if (!pending.active()) return;
         pending.target += pending.weight * addTarget;
@@ -217,6 +279,35 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         SurfaceInteraction si;
         ++stats.rays;
         bool found = scene_.intersect(ray, &si);
+        if (media && pm.medium >= 0) {
+            // Free flight to the surface (or to infinity) through the current medium.
+            const Medium& medium = *scene_.media[size_t(pm.medium)];
+            MediumSample ms = medium.sample(ray.o, ray.d, found ? si.t : ray.tMax, rng);
+            beta *= ms.weight;
+            if (isBlack(beta) || !isFinite(beta)) break;
+            if (ms.scattered) {
+                // A medium vertex: NEE with MIS against the phase function, then a phase
+                // sample (guiding acts only at surface vertices for now).
+                pending = PendingRecord();
+                if (bounces >= maxDepth_) break;
+                Vec3 p = ray.o + ms.t * ray.d, wo = -ray.d;
+                L += beta * sampleLightMedium(p, wo, medium.g(), pm, sampler, stats);
+                float phasePdf;
+                Vec3 wi = sampleHenyeyGreenstein(wo, medium.g(), sampler.get2D(), &phasePdf);
+                if (!(phasePdf > 0.f)) break;
+                dirPdf = phasePdf;  // the sample weight phase / pdf is 1
+                specularBounce = false;
+                prev = LightSampleContext{p, Vec3(0.f)};
+                ray = Ray(p, wi);
+                Spectrum rrBeta = beta * etaScale;
+                if (maxComponent(rrBeta) < rrThreshold_ && bounces > 3) {
+                    float q = std::max(0.05f, 1.f - maxComponent(rrBeta));
+                    if (sampler.get1D() < q) break;
+                    beta /= 1.f - q;
+                }
+                continue;
+            }
+        }
         // Emission reached by the previous scattering (or seen by the camera), weighted by
         // MIS against next-event estimation.
         if (!found) {
@@ -254,8 +345,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         // Medium boundaries without a surface: continue the ray unchanged.
         if (si.material < 0) {
-            if (bounces >= maxDepth_ || ++passThroughs > 256) break;
+            // (With media, as volpath, light found through boundaries after the last vertex
+            // still counts; path's shadow rays stop at them.)
+            if ((bounces >= maxDepth_ && !media) || ++passThroughs > 256) break;
             if (pending.active()) pending.target += pending.weight * emitted;
+            if (media) pm.medium = si.mediumAfter(ray.d, pm.medium);
             ray.o = spawnOrigin(si, ray.d, originScale_);
             --bounces;
             continue;
@@ -276,7 +370,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (!lastVertex) {
             ++stats.vertices;
             if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
-                L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats);
+                L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats,
+                                        media ? &pm : nullptr);
         }
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
         // y, carried unchanged through delta vertices.
@@ -324,6 +419,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
         }
         prev = LightSampleContext{si.p, si.ng};
+        if (media) pm.medium = si.mediumAfter(ds.wi, pm.medium);
         ray.o = spawnOrigin(si, ds.wi, originScale_);
         ray.d = ds.wi;
         ray.tMax = Infinity;

@@ -43,6 +43,8 @@ struct GuideSettings {
     bool sampledTarget = true;
 };
 
+class Rng;
+
 class PathIntegrator {
 public:
     PathIntegrator(const Scene& scene, const GuideSettings& guide = {});
@@ -67,8 +69,22 @@ private:
     float regionMix(int region) const {
         return region >= 0 ? guide_.mix * guide_.field->confidence(region) : 0.f;
     }
+    // Media (scene_.hasMedia() only): the medium a path is in and its tracking generator.
+    struct PathMedium {
+        int medium = -1;
+        Rng* rng = nullptr;
+    };
     Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                         Sampler& sampler, PathStats& stats) const;
+                         Sampler& sampler, PathStats& stats,
+                         const PathMedium* media = nullptr) const;
+    // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
+    // against phase sampling.
+    Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, const PathMedium& pm,
+                               Sampler& sampler, PathStats& stats) const;
+    // Transmittance of the segment o + t d, t in (0, tMax), starting in `medium`: through
+    // medium boundaries (interface-only surfaces), zero at any other surface.
+    Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
+                           PathStats& stats) const;
     // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance).
     float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                           const Vec3& woY) const;

@@ -18,6 +18,14 @@ struct SurfaceInteraction {
     int material = -1;  // index into Scene::materials; -1 = interface only (no surface)
     int light = -1;     // index into Scene::lights when the surface emits
     int primitive = -1; // index of the shape record (for statistics and debugging)
+    // Media on the two sides (indices into Scene::media, -1 = none); a boundary when they
+    // differ: a ray leaving along w enters mediumOutside if dot(w, ng) > 0, else mediumInside.
+    int mediumInside = -1, mediumOutside = -1;
+    bool isMediumTransition() const { return mediumInside != mediumOutside; }
+    int mediumAfter(const Vec3& w, int current) const {
+        if (mediumInside == mediumOutside) return current;
+        return glm::dot(w, ng) > 0.f ? mediumOutside : mediumInside;
+    }
 };
 
 }  // namespace rlpbrt

@@ -41,6 +41,8 @@ void printSummary(const SceneDesc& desc, const Scene& scene, const Diagnostics& 
                 s.lights - s.areaLights);
     std::printf("materials: %zu\n", s.materials);
     std::printf("textures: %zu\n", s.textures);
+    std::printf("media: %zu rendered of %zu defined%s\n", scene.media.size(), desc.media.size(),
+                scene.cameraMedium >= 0 ? ", camera inside a medium" : "");
     std::printf("camera: %s, film %dx%d, sampler %s %d spp, integrator %s maxdepth %d\n",
                 desc.camera.present ? desc.camera.type.c_str() : "perspective",
                 scene.filmParams.xResolution, scene.filmParams.yResolution,

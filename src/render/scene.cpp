@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 
+#include "render/media.h"
 #include "render/sampling.h"
 #include "render/spectrum.h"
 #include "render/transform.h"
@@ -148,6 +149,8 @@ void Scene::hitDetails(const Primitive& prim, unsigned primID, float u, float v,
                        SurfaceInteraction* si) const {
     si->t = t;
     si->material = prim.material;
+    si->mediumInside = prim.mediumInside;
+    si->mediumOutside = prim.mediumOutside;
     si->light = -1;
     si->shadingTangent = Vec3(0.f);
     si->dndu = si->dndv = Vec3(0.f);
@@ -512,7 +515,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         bool isKnown = false;
         for (const char* k : known) isKnown |= is.name == k;
         if (!isKnown) diag.error(in.loc, "unknown integrator \"" + is.name + "\"");
-        if (is.name != "path") {
+        if (is.name != "path" && is.name != "volpath") {
             in.params.markAllUsed();
             diag.ignored(in.loc, "integrator \"" + is.name + "\" is rendered with rlpbrt's path "
                                  "tracer (maxdepth " + std::to_string(is.maxDepth) + ")");
@@ -523,10 +526,30 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         desc.accelerator.params.markAllUsed();
         diag.ignored(desc.accelerator.loc, "Accelerator is ignored: rlpbrt always uses Embree");
     }
-    if (!desc.media.empty())
-        diag.ignored(desc.media[0].loc, "participating media are not supported yet; media are "
-                                        "ignored (surfaces only)");
-    for (const auto& m : desc.media) m.params.markAllUsed();
+    // --- Media (pbrt-v3: volpath, bdpt and mlt render them; path and the others ignore
+    // them). mediumIndex[i] = index in s.media of desc.media[i], -1 if not made.
+    std::vector<int> mediumIndex(desc.media.size(), -1);
+    {
+        const std::string& in = s.integrator.name;
+        bool mediaIntegrator = in == "volpath" || in == "bdpt" || in == "mlt";
+        // Media are made (and their errors reported) whatever the integrator.
+        for (size_t i = 0; i < desc.media.size(); ++i) {
+            std::unique_ptr<Medium> m = createMedium(desc.media[i], diag);
+            if (!m || !mediaIntegrator) continue;
+            mediumIndex[i] = int(s.media.size());
+            s.media.push_back(std::move(m));
+        }
+        if (!desc.media.empty() && !mediaIntegrator)
+            diag.warning(desc.media[0].loc, "integrator \"" + in + "\" ignores participating "
+                                            "media (as in pbrt-v3); use \"volpath\" to render them");
+    }
+    auto mediumByName = [&](const std::string& name) {
+        if (name.empty()) return -1;
+        for (size_t i = 0; i < desc.media.size(); ++i)
+            if (desc.media[i].name == name) return mediumIndex[i];
+        return -1;
+    };
+    s.cameraMedium = mediumByName(desc.cameraMedium);
 
     // --- Textures, in definition order (each sees the textures defined before it).
     MipMapCache mipCache;
@@ -577,6 +600,8 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         Primitive prim;
         if (!createShape(e, diag, &prim.shape)) return;
         prim.material = materialIndexFor(desc, e.material, runtimeMaterial);
+        prim.mediumInside = mediumByName(e.insideMedium);
+        prim.mediumOutside = mediumByName(e.outsideMedium);
         if (allowLights && e.areaLight >= 0) {
             const Entity& al = desc.areaLights[size_t(e.areaLight)];
             std::vector<std::unique_ptr<Light>> made;

@@ -30,6 +30,7 @@ struct Primitive {
     ShapeData shape;
     int material = -1;   // -1 = interface only
     int lightBase = -1;  // first light index (meshes: one light per triangle)
+    int mediumInside = -1, mediumOutside = -1;  // indices into Scene::media (-1: vacuum)
 };
 
 // A set of primitives with their Embree scene: the world, or one object for instancing.
@@ -62,6 +63,7 @@ struct BuildOptions {
     int nThreads = 0;
 };
 
+class Medium;
 class Scene;
 std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& options,
                                   Diagnostics& diag);
@@ -91,6 +93,12 @@ public:
     std::vector<std::unique_ptr<Material>> materials;
     std::vector<std::unique_ptr<Light>> lights;
     std::vector<int> infiniteLights;  // indices into lights
+    // Participating media (empty unless the scene has media and its Integrator handles them,
+    // as pbrt-v3's volpath does; `path` ignores media as in pbrt-v3). Surfaces whose two
+    // media differ are medium boundaries; rays start in cameraMedium.
+    std::vector<std::unique_ptr<Medium>> media;
+    int cameraMedium = -1;
+    bool hasMedia() const { return !media.empty(); }
     std::unique_ptr<Camera> camera;
     std::shared_ptr<const Filter> filter;
     FilmParams filmParams;

@@ -129,6 +129,9 @@ void SceneBuilder::camera(const std::string& type, ParamList params, FileLoc loc
     desc_.cameraFromWorld = gs_.ctm[0];
     namedCoordSys_["camera"] = glm::inverse(gs_.ctm[0]);
     desc_.cameraMedium = gs_.outside;
+    if (!gs_.outside.empty() && !desc_.findMedium(gs_.outside))
+        diag_.error(gs_.mediumLoc.file ? gs_.mediumLoc : loc,
+                    "undefined medium \"" + gs_.outside + "\" for the camera");
 }
 void SceneBuilder::sampler(const std::string& type, ParamList params, FileLoc loc) {
     setOption(desc_.sampler, "Sampler", type, std::move(params), loc);
