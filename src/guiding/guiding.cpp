@@ -3,9 +3,11 @@
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "guiding/hemi.h"
+#include "guiding/vdb.h"
 
 namespace rlpbrt::guiding {
 
@@ -14,6 +16,16 @@ GuidingField::~GuidingField() = default;
 float GuidingField::irradianceEstimate(int region, const glm::vec3& n) const {
     return scatteredEstimate(region,
                              [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
+}
+
+bool GuidingField::save(const std::string&, std::string* error) const {
+    *error = "this guiding backend cannot save its field";
+    return false;
+}
+
+bool GuidingField::load(const std::string&, std::string* error) {
+    *error = "this guiding backend cannot load a field";
+    return false;
 }
 
 namespace {
@@ -115,6 +127,86 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
     return true;
 }
 
+// Reads the vdb parameters; false and *error on an unknown key or a bad value.
+bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams* vp,
+                    double* maxMiB, std::string* error) {
+    auto bad = [&](const std::string& key, const std::string& value, const char* expected) {
+        *error = "guiding backend 'vdb': bad value '" + value + "' for parameter '" + key +
+                 "' (expected " + expected + ")";
+        return false;
+    };
+    for (const auto& [key, value] : params) {
+        double d = 0.0;
+        uint64_t u = 0;
+        if (key == "alpha") {
+            if (value == "visits") {
+                vp->alphaVisits = true;
+            } else if (parseDouble(value, &d) && d > 0.0 && d <= 1.0) {
+                vp->alphaVisits = false;
+                vp->fixedAlpha = d;
+            } else {
+                return bad(key, value, "'visits' or a number in (0, 1]");
+            }
+        } else if (key == "strata") {
+            const char* expected = "WxH or N with integers in 1..64";
+            size_t x = value.find_first_of("xX");
+            uint64_t w = 0, h = 0;
+            if (x == std::string::npos) {
+                if (!parseUnsigned(value, 64, &w)) return bad(key, value, expected);
+                h = w;
+            } else if (!parseUnsigned(value.substr(0, x), 64, &w) ||
+                       !parseUnsigned(value.substr(x + 1), 64, &h)) {
+                return bad(key, value, expected);
+            }
+            if (w < 1 || h < 1) return bad(key, value, expected);
+            vp->cols = int(w);
+            vp->rows = int(h);
+        } else if (key == "voxel") {
+            if (!parseUnsigned(value, 4096, &u) || u < 1)
+                return bad(key, value, "a voxel count along the longest axis, 1..4096");
+            vp->voxelCount = int(u);
+        } else if (key == "voxel-size") {
+            if (!parseDouble(value, &d) || !(d > 0.0))
+                return bad(key, value, "a positive voxel edge in world units");
+            vp->voxelSize = d;
+        } else if (key == "points") {
+            if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
+                return bad(key, value, "an integer in 1..67108864");
+            vp->points = u;
+        } else if (key == "dirs") {
+            if (value != "hemi" && value != "sphere") return bad(key, value, "hemi or sphere");
+            vp->sphere = value == "sphere";
+        } else if (key == "init") {
+            if (!parseDouble(value, &d) || !(d > 0.0) || d > double(FLT_MAX))
+                return bad(key, value, "a positive number <= 3.4e38");
+            vp->init = d;
+        } else if (key == "epsilon") {
+            if (!parseDouble(value, &d) || d < 0.0 || d > 1.0)
+                return bad(key, value, "a number in [0, 1]");
+            vp->epsilon = d;
+        } else if (key == "cosine") {
+            if (value != "0" && value != "1") return bad(key, value, "0 or 1");
+            vp->cosine = value == "1";
+        } else if (key == "max-mb") {
+            if (!parseDouble(value, &d) || !(d > 0.0)) return bad(key, value, "a positive number");
+            *maxMiB = d;
+        } else if (key == "mix" || key == "target") {
+            // Consumed by the integrator.
+        } else {
+            *error = "guiding backend 'vdb': unknown parameter '" + key +
+                     "' (known: alpha, strata, voxel, voxel-size, points, dirs, init, epsilon, "
+                     "cosine, max-mb, mix, target)";
+            return false;
+        }
+    }
+    if (vp->voxelCount > 0 && vp->voxelSize > 0.0) {
+        *error = "guiding backend 'vdb': give 'voxel' (a count) or 'voxel-size' (world units), "
+                 "not both";
+        return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
@@ -143,7 +235,27 @@ std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
         }
         return std::make_unique<HemiField>(hp, scene);
     }
-    *error = "unknown guiding backend '" + config.backend + "' (available: none, hemi)";
+    if (config.backend == "vdb") {
+        VdbParams vp;
+        double maxMiB = 4096.0;
+        if (!parseVdbParams(config.params, &vp, &maxMiB, error)) return nullptr;
+        if (!scene.samplePoint) {
+            *error = "guiding backend 'vdb': the scene provides no surface sampler";
+            return nullptr;
+        }
+        const double mib = vdbEstimatedBytes(vp, scene) / (1024.0 * 1024.0);
+        if (mib > maxMiB) {
+            char buf[256];
+            std::snprintf(buf, sizeof(buf),
+                          "guiding backend 'vdb': voxel size %g with %dx%d strata needs up to "
+                          "about %.0f MiB, more than max-mb=%g",
+                          vdbVoxelSize(vp, scene), vp.cols, vp.rows, mib, maxMiB);
+            *error = buf;
+            return nullptr;
+        }
+        return std::make_unique<VdbField>(vp, scene);
+    }
+    *error = "unknown guiding backend '" + config.backend + "' (available: none, hemi, vdb)";
     return nullptr;
 }
 

@@ -6,25 +6,14 @@
 #include <cstdio>
 
 #include <nanoflann.hpp>
+#include "guiding/field_io.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 namespace rlpbrt::guiding {
 
 namespace {
-
-// Radical inverse of i in a prime base: the Halton sequence's coordinate, in [0, 1).
-float radicalInverse(uint64_t i, uint64_t base) {
-    const double invBase = 1.0 / static_cast<double>(base);
-    double inv = invBase, value = 0.0;
-    while (i > 0) {
-        uint64_t next = i / base;
-        value += static_cast<double>(i - next * base) * inv;
-        inv *= invBase;
-        i = next;
-    }
-    return std::min(static_cast<float>(value), 0x1.fffffep-1f);
-}
 
 bool finite3(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -64,6 +53,9 @@ double hemiEstimatedBytes(const HemiParams& p) {
 HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     : params_(params),
       layout_(params.cols, params.rows),
+      sceneMin_(scene.boundsMin),
+      sceneMax_(scene.boundsMax),
+      sceneArea_(scene.totalArea),
       strata_(params.cols * params.rows),
       cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * kPi / 180.0))) {
     // Uniform points over the surface: a Halton sequence through the scene's area sampler.
@@ -349,5 +341,92 @@ std::string HemiField::describe() const {
 }
 
 GuidingStats HemiField::stats() const { return stats_; }
+
+bool HemiField::save(const std::string& path, std::string* error) const {
+    fieldio::Writer w;
+    w.raw(fieldio::kMagic, 8);
+    w.u32(fieldio::kVersion);
+    w.str("hemi");
+    w.vec3(sceneMin_);
+    w.vec3(sceneMax_);
+    w.f64(sceneArea_);
+    w.u64(positions_.size());
+    w.u64(attempts_);
+    w.u32(uint32_t(params_.cols));
+    w.u32(uint32_t(params_.rows));
+    w.u64(stats_.passes);
+    w.u64(stats_.records);
+    w.u64(stats_.rejectedTargets);
+    w.u64(stats_.rejectedRecords);
+    w.u64(uint64_t(numRegions()));
+    w.data.reserve(w.data.size() + q_.size() * 16);
+    for (double q : q_) w.f64(q);
+    for (uint64_t v : visits_) w.u64(v);
+    if (!fieldio::writeFile(path, w.data, error)) return false;
+    return true;
+}
+
+bool HemiField::load(const std::string& path, std::string* error) {
+    const std::string kind = fieldio::fileKind(path);
+    if (kind.empty()) {
+        *error = "'" + path + "' is not a saved guiding field (or cannot be read)";
+        return false;
+    }
+    if (kind != "hemi") {
+        *error = "'" + path + "' holds a '" + kind +
+                 "' guiding field; the hemi backend loads only fields it saved";
+        return false;
+    }
+    std::string data;
+    if (!fieldio::readFile(path, &data, error)) return false;
+    auto fail = [&](const std::string& why) {
+        *error = "'" + path + "': " + why;
+        return false;
+    };
+    fieldio::Reader r(data);
+    r.skip(8);
+    const uint32_t version = r.u32();
+    r.str();
+    if (version != fieldio::kVersion) return fail("unsupported version " + std::to_string(version));
+    const glm::vec3 bmin = r.vec3(), bmax = r.vec3();
+    const double area = r.f64();
+    const uint64_t points = r.u64(), attempts = r.u64();
+    const uint32_t cols = r.u32(), rows = r.u32();
+    GuidingStats s;
+    s.passes = r.u64();
+    s.records = r.u64();
+    s.rejectedTargets = r.u64();
+    s.rejectedRecords = r.u64();
+    const uint64_t regions = r.u64();
+    if (!r.ok()) return fail("truncated header");
+    std::string why;
+    if (!fieldio::sameScene(bmin, bmax, area, sceneMin_, sceneMax_, sceneArea_, &why))
+        return fail(why);
+    if (points != positions_.size() || attempts != attempts_ || regions != uint64_t(numRegions()))
+        return fail("made with " + std::to_string(points) + " points, this field has " +
+                    std::to_string(positions_.size()) + " (use the same points parameter)");
+    if (int(cols) != params_.cols || int(rows) != params_.rows)
+        return fail("strata " + std::to_string(cols) + "x" + std::to_string(rows) +
+                    ", this field has " + std::to_string(params_.cols) + "x" +
+                    std::to_string(params_.rows));
+    const size_t count = q_.size();
+    if (r.remaining() != count * 16) return fail("table size does not match the header");
+    std::vector<double> q(count);
+    std::vector<uint64_t> visits(count);
+    for (double& d : q) {
+        d = r.f64();
+        if (!(d >= 0.0) || !std::isfinite(d)) return fail("corrupt Q table");
+    }
+    for (uint64_t& v : visits) v = r.u64();
+    if (!r.ok()) return fail("truncated tables");
+    q_ = std::move(q);
+    visits_ = std::move(visits);
+    for (int region = 0; region < numRegions(); ++region) {
+        buildPolicy(&q_[index(region, 0)], &cdf_[size_t(region) * size_t(strata_ + 1)]);
+        mirrorRegion(region);
+    }
+    stats_ = s;
+    return true;
+}
 
 }  // namespace rlpbrt::guiding

@@ -59,6 +59,9 @@ public:
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;
+    // Little-endian binary file, docs/GUIDE_FILES.md.
+    bool save(const std::string& path, std::string* error) const override;
+    bool load(const std::string& path, std::string* error) override;
 
     // Inspection (tests, tools).
     // Bytes of the per-pass record buffers and endPass scratch (not counted in bytes()).
@@ -111,6 +114,8 @@ private:
 
     HemiParams params_;
     StrataLayout layout_;
+    glm::vec3 sceneMin_, sceneMax_;  // the scene fingerprint of saved fields
+    double sceneArea_;
     int strata_;
     float cosMaxAngle_;
     std::vector<glm::vec3> positions_;  // one per surface sample
