@@ -1,5 +1,6 @@
 // Correctness against pbrt-v3: every surface scene of ../shared/references/manifest.tsv is
-// rendered at 64 spp (fixed seed) with --guide=none and compared with pbrt-v3's reference.
+// rendered at 64 spp (fixed seed) with every guiding backend (none, hemi, vdb) and compared
+// with pbrt-v3's reference.
 // Bounds (issue "path tracer" acceptance): relMSE <= 1.5x pbrt-v3's own 64-spp relMSE;
 // median block deviation <= max(2%, 1.5x pbrt-v3's own 64-spp figure); no NaN/Inf.
 #include <fstream>
@@ -54,7 +55,7 @@ const char* kSurfaceScenes[] = {
 };
 
 // Every backend must pass the same test: guiding changes the noise, never the expectation.
-const char* kGuides[] = {"none", "hemi"};
+const char* kGuides[] = {"none", "hemi", "vdb"};
 
 class ReferenceTest
     : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
