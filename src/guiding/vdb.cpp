@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tree/ValueAccessor.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include "guiding/field_io.h"
 
@@ -40,6 +42,8 @@ using ConstAccessor = openvdb::tree::ValueAccessor<const openvdb::Int32Tree, fal
 
 struct VdbField::Grid {
     openvdb::Int32Grid::Ptr grid;
+    // Per-thread accessors (Accessor::PerThread), created on first use by each thread.
+    mutable tbb::enumerable_thread_specific<std::unique_ptr<ConstAccessor>> accessors;
 };
 
 double vdbVoxelSize(const VdbParams& params, const SceneInfo& scene) {
@@ -192,14 +196,50 @@ int VdbField::voxelIndex(const glm::ivec3& ijk) const {
 }
 
 int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
+    switch (accessor_) {
+    case Accessor::PerThread: {
+        std::unique_ptr<ConstAccessor>& acc = grid_->accessors.local();
+        if (!acc) acc = std::make_unique<ConstAccessor>(grid_->grid->tree());
+        return lookupWith(p, n, *acc);
+    }
+    case Accessor::Uncached:
+        return lookupWith(p, n, grid_->grid->tree());
+    case Accessor::PerLookup: {
+        ConstAccessor acc(grid_->grid->tree());
+        return lookupWith(p, n, acc);
+    }
+    case Accessor::Hybrid:
+    default: {
+        // Vertices on surfaces almost always hit an active voxel: one uncached probe (no
+        // accessor to set up); the neighbour search, 26 nearby probes, goes through an
+        // accessor made on demand.
+        struct HybridProbe {
+            const openvdb::Int32Tree& tree;
+            std::optional<ConstAccessor> acc;
+            bool first = true;
+            int getValue(const openvdb::Coord& c) {
+                if (first) {
+                    first = false;
+                    return tree.getValue(c);
+                }
+                if (!acc) acc.emplace(tree);
+                return acc->getValue(c);
+            }
+        } probe{grid_->grid->tree(), std::nullopt};
+        return lookupWith(p, n, probe);
+    }
+    }
+}
+
+template <class Probe>
+int VdbField::lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) const {
     if (voxelNormals_.empty() || !finite3(p)) return -1;
     if (!params_.sphere && !(glm::dot(n, n) > 0.f)) return -1;
     const glm::vec3 c = glm::floor((p - origin_) * invVoxel_);
     if (!(std::abs(c.x) < kMaxCoord && std::abs(c.y) < kMaxCoord && std::abs(c.z) < kMaxCoord))
         return -1;
     const openvdb::Coord ijk(int(c.x), int(c.y), int(c.z));
-    ConstAccessor acc(grid_->grid->tree());
-    int v = acc.getValue(ijk);
+    int v = probe.getValue(ijk);
     if (v < 0) {
         // The nearest active voxel among the 26 neighbours (distance from p to the voxel's
         // box; ties go to the first in z, y, x order), else no data.
@@ -209,7 +249,7 @@ int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dx = -1; dx <= 1; ++dx) {
                     if (!(dx | dy | dz)) continue;
-                    int vi = acc.getValue(ijk.offsetBy(dx, dy, dz));
+                    int vi = probe.getValue(ijk.offsetBy(dx, dy, dz));
                     if (vi < 0) continue;
                     auto axis = [](int d, float t) {
                         return d < 0 ? t : (d > 0 ? 1.f - t : 0.f);
@@ -500,6 +540,7 @@ bool VdbField::load(const std::string& path, std::string* error) {
         grid->clearMetadata();
         grid->setName(kGridName);
         grid_->grid = grid;
+        grid_->accessors.clear();
         voxelNormals_ = std::move(normals);
         buildFrames();
         table_.reset(regions, int(strata), params_.init, policy());

@@ -93,6 +93,13 @@ public:
     size_t scratchBytes() const { return table_.scratchBytes(); }
     // Bytes of the OpenVDB tree alone.
     size_t gridBytes() const;
+    // How lookup() reads the grid (benchmarks; not thread-safe against running lookups):
+    // a fresh non-registering ValueAccessor per lookup, one cached accessor per thread
+    // (tbb::enumerable_thread_specific), the tree's uncached getValue, or (default) the
+    // uncached getValue for the vertex's voxel and an accessor only when the 26 neighbours
+    // must be searched. Measured in bench/guide_lookup_bench.cpp (docs/BENCHMARKS.md).
+    enum class Accessor { PerLookup, PerThread, Uncached, Hybrid };
+    void setAccessor(Accessor mode) { accessor_ = mode; }
 
 private:
     struct Grid;  // the OpenVDB grid, defined in vdb.cpp
@@ -115,6 +122,9 @@ private:
     std::vector<HemiFrame> frames_;        // per region
     std::vector<float> centreX_, centreY_, centreZ_;  // local stratum centres (all strata)
     StrataTable table_;
+    Accessor accessor_ = Accessor::Hybrid;
+    template <class Probe>
+    int lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) const;
 };
 
 }  // namespace rlpbrt::guiding

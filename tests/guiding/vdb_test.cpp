@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -272,6 +273,30 @@ TEST(VdbField, LookupFindsSurfaceVoxelsAndNothingFarAway) {
     int w = f->lookup(offWall, glm::vec3(1, 0, 0));
     ASSERT_GE(w, 0);
     EXPECT_EQ(f->regionVoxel(w), f->voxelIndex(f->voxelCoord(glm::vec3(0.f, 0.53f, 0.53f))));
+}
+
+TEST(VdbField, AccessorModesGiveTheSameLookups) {
+    auto f = makeVdb(cornerScene(), {{"voxel", "16"}});
+    ASSERT_TRUE(f);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<float> uni(-0.1f, 1.1f);
+    std::vector<std::pair<glm::vec3, glm::vec3>> queries;
+    for (int i = 0; i < 20000; ++i) {
+        glm::vec3 p(uni(rng), uni(rng), 0.15f * uni(rng));  // near the floor, some misses
+        queries.emplace_back(p, gaussianDirection(rng));
+    }
+    std::vector<int> reference;
+    for (const auto& [p, n] : queries) reference.push_back(f->lookup(p, n));
+    EXPECT_GT(std::count(reference.begin(), reference.end(), -1), 100);
+    for (auto mode : {VdbField::Accessor::PerLookup, VdbField::Accessor::PerThread,
+                      VdbField::Accessor::Uncached, VdbField::Accessor::Hybrid}) {
+        f->setAccessor(mode);
+        std::vector<int> got(queries.size());
+        tbb::parallel_for(size_t(0), queries.size(), [&](size_t i) {
+            got[i] = f->lookup(queries[i].first, queries[i].second);
+        });
+        EXPECT_EQ(got, reference) << int(mode);
+    }
 }
 
 TEST(VdbField, UntrainedSamplingMatchesPdf) {
