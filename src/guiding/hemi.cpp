@@ -6,10 +6,8 @@
 #include <cstdio>
 
 #include <nanoflann.hpp>
-#include "guiding/field_io.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "guiding/field_io.h"
 
 namespace rlpbrt::guiding {
 
@@ -78,21 +76,12 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     }
     tree_ = std::make_unique<KdTree>(positions_);
 
-    const size_t regions = positions_.size() * 2, n = size_t(strata_);
-    q_.assign(regions * n, params.init);
-    qf_.assign(regions * n, float(std::min(params.init, double(FLT_MAX))));
     for (int j = 0; j < strata_; ++j) {
         centreX_.push_back(layout_.centre(j).x);
         centreY_.push_back(layout_.centre(j).y);
         centreZ_.push_back(layout_.centre(j).z);
     }
-    visits_.assign(regions * n, 0);
-    cdf_.resize(regions * (n + 1));
-    if (regions > 0) {
-        buildPolicy(q_.data(), cdf_.data());
-        for (size_t r = 1; r < regions; ++r)
-            std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
-    }
+    table_.reset(positions_.size() * 2, strata_, params.init, policy());
 }
 
 HemiField::~HemiField() = default;
@@ -157,7 +146,7 @@ float HemiField::scatteredEstimate(int region,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (!validRegion(region)) return 0.f;
     HemiFrame frame = HemiFrame::fromZ(regionNormal(region));
-    const double* q = &q_[index(region, 0)];
+    const double* q = table_.q(size_t(region));
     double acc = 0.0;
     for (int j = 0; j < strata_; ++j) {
         float f = fcos(frame.toWorld(layout_.centre(j)));
@@ -173,7 +162,7 @@ float HemiField::irradianceEstimate(int region, const glm::vec3& n) const {
     const glm::vec3 nl = frame.toLocal(n);
     // Float copy of Q and per-axis centres: a short, vectorizable loop (this runs at every
     // Lambertian path vertex that completes a training record).
-    const float* q = &qf_[index(region, 0)];
+    const float* q = table_.qf(size_t(region));
     const float *cx = centreX_.data(), *cy = centreY_.data(), *cz = centreZ_.data();
     float acc = 0.f;
     for (int j = 0; j < strata_; ++j) {
@@ -187,69 +176,23 @@ float HemiField::irradianceEstimate(int region, const glm::vec3& n) const {
 float HemiField::radiance(int region, const glm::vec3& w) const {
     int j = stratumOf(region, w);
     if (j < 0) return 0.f;
-    return static_cast<float>(std::min(q_[index(region, j)], double(FLT_MAX)));
+    return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
 }
 
-void HemiField::beginPass(int numSlots) {
-    numSlots = std::max(numSlots, 0);
-    if (slots_.size() != size_t(numSlots)) slots_.resize(size_t(numSlots));
-    for (SlotBuffer& s : slots_) {
-        s.records.clear();  // keeps the capacity of earlier passes
-        s.rejectedTargets = s.rejectedRecords = 0;
-    }
-}
+void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target) {
-    if (slot < 0 || size_t(slot) >= slots_.size()) return;  // no pass open for this slot
-    SlotBuffer& buf = slots_[size_t(slot)];
+    if (!table_.slotOpen(slot)) return;  // no pass open for this slot
     if (!(target >= 0.f) || !std::isfinite(target)) {
-        ++buf.rejectedTargets;
+        table_.rejectTarget(slot);
         return;
     }
     int j = stratumOf(region, w);
     if (j < 0) {
-        ++buf.rejectedRecords;
+        table_.rejectRecord(slot);
         return;
     }
-    buf.records.push_back(Record{uint32_t(region), uint16_t(j), target});
-}
-
-void HemiField::applyRegion(int region, const Record* begin, const Record* end, double* sums,
-                            uint64_t* counts) {
-    std::fill(sums, sums + strata_, 0.0);
-    std::fill(counts, counts + strata_, uint64_t(0));
-    for (const Record* r = begin; r != end; ++r) {  // merge order: slot, then record order
-        sums[r->stratum] += double(r->target);
-        ++counts[r->stratum];
-    }
-    double* q = &q_[index(region, 0)];
-    uint64_t* visits = &visits_[index(region, 0)];
-    for (int j = 0; j < strata_; ++j) {
-        const uint64_t m = counts[j];
-        if (m == 0) continue;
-        const double mean = sums[j] / double(m);
-        double updated;
-        if (params_.alphaVisits) {
-            // m sequential updates with alpha = 1/(1 + visits): the running mean of all targets.
-            const double nOld = double(visits[j]);
-            updated = (nOld * q[j] + sums[j]) / (nOld + double(m));
-        } else {
-            // m updates with a fixed alpha and the batch mean as target: keep (1 - alpha)^m.
-            const double keep = std::exp(double(m) * std::log1p(-params_.fixedAlpha));
-            updated = keep * q[j] + (1.0 - keep) * mean;
-        }
-        // Both are convex combinations of finite non-negative values; guard regardless.
-        q[j] = (std::isfinite(updated) && updated >= 0.0) ? updated : mean;
-        visits[j] += m;
-    }
-    buildPolicy(q, &cdf_[size_t(region) * size_t(strata_ + 1)]);
-    mirrorRegion(region);
-}
-
-void HemiField::mirrorRegion(int region) {
-    const double* q = &q_[index(region, 0)];
-    float* qf = &qf_[index(region, 0)];
-    for (int j = 0; j < strata_; ++j) qf[j] = float(std::min(q[j], double(FLT_MAX)));
+    table_.record(slot, uint32_t(region), j, target);
 }
 
 void HemiField::buildPolicy(const double* q, float* cdf) const {
@@ -262,61 +205,17 @@ void HemiField::buildPolicy(const double* q, float* cdf) const {
     buildStrataCdf(qc, strata_, params_.epsilon, cdf);
 }
 
-void HemiField::endPass() {
-    const size_t regions = size_t(numRegions());
-    uint64_t total = 0;
-    for (const SlotBuffer& s : slots_) {
-        total += s.records.size();
-        stats_.rejectedTargets += s.rejectedTargets;
-        stats_.rejectedRecords += s.rejectedRecords;
-    }
-    ++stats_.passes;
-    stats_.records += total;
-    if (total > 0 && regions > 0) {
-        // Stable counting sort by region: within a region, records stay in slot order.
-        regionStart_.assign(regions + 1, 0);
-        for (const SlotBuffer& s : slots_)
-            for (const Record& r : s.records) ++regionStart_[r.region + 1];
-        for (size_t r = 0; r < regions; ++r) regionStart_[r + 1] += regionStart_[r];
-        merged_.resize(total);
-        for (const SlotBuffer& s : slots_)
-            for (const Record& r : s.records) merged_[regionStart_[r.region]++] = r;
-        // regionStart_[r] now holds the end of region r, i.e. the start of region r + 1.
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 256),
-                          [&](const tbb::blocked_range<size_t>& range) {
-                              std::vector<double> sums(static_cast<size_t>(strata_));
-                              std::vector<uint64_t> counts(static_cast<size_t>(strata_));
-                              for (size_t r = range.begin(); r != range.end(); ++r) {
-                                  size_t b = r == 0 ? 0 : regionStart_[r - 1];
-                                  size_t e = regionStart_[r];
-                                  if (b == e) continue;
-                                  applyRegion(int(r), merged_.data() + b, merged_.data() + e,
-                                              sums.data(), counts.data());
-                              }
-                          });
-    }
-    for (SlotBuffer& s : slots_) {
-        s.records.clear();
-        s.rejectedTargets = s.rejectedRecords = 0;
-    }
-}
+void HemiField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy()); }
 
 size_t HemiField::bytes() const {
-    size_t b = q_.capacity() * sizeof(double) + qf_.capacity() * sizeof(float) +
-               visits_.capacity() * sizeof(uint64_t) +
-               cdf_.capacity() * sizeof(float) +
-               (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3);
+    size_t b = table_.bytes() + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3);
     // kd-tree: one index per point plus about two nodes per leaf.
     b += positions_.size() * sizeof(uint32_t) +
          (positions_.size() / kTreeLeafSize + 1) * 2 * sizeof(KdTree::Index::Node);
     return b;
 }
 
-size_t HemiField::scratchBytes() const {
-    size_t b = merged_.capacity() * sizeof(Record) + regionStart_.capacity() * sizeof(uint64_t);
-    for (const SlotBuffer& s : slots_) b += s.records.capacity() * sizeof(Record);
-    return b;
-}
+size_t HemiField::scratchBytes() const { return table_.scratchBytes(); }
 
 std::string HemiField::describe() const {
     char alpha[32];
@@ -334,13 +233,13 @@ std::string HemiField::describe() const {
                   params_.rows, alpha, params_.normalAngleDeg, params_.knn, params_.init,
                   params_.epsilon, double(bytes()) / (1024.0 * 1024.0),
                   double(scratchBytes()) / (1024.0 * 1024.0),
-                  (unsigned long long)stats_.passes, (unsigned long long)stats_.records,
-                  (unsigned long long)stats_.rejectedTargets,
-                  (unsigned long long)stats_.rejectedRecords);
+                  (unsigned long long)stats().passes, (unsigned long long)stats().records,
+                  (unsigned long long)stats().rejectedTargets,
+                  (unsigned long long)stats().rejectedRecords);
     return buf;
 }
 
-GuidingStats HemiField::stats() const { return stats_; }
+GuidingStats HemiField::stats() const { return table_.stats(); }
 
 bool HemiField::save(const std::string& path, std::string* error) const {
     fieldio::Writer w;
@@ -354,14 +253,15 @@ bool HemiField::save(const std::string& path, std::string* error) const {
     w.u64(attempts_);
     w.u32(uint32_t(params_.cols));
     w.u32(uint32_t(params_.rows));
-    w.u64(stats_.passes);
-    w.u64(stats_.records);
-    w.u64(stats_.rejectedTargets);
-    w.u64(stats_.rejectedRecords);
+    const GuidingStats& st = table_.stats();
+    w.u64(st.passes);
+    w.u64(st.records);
+    w.u64(st.rejectedTargets);
+    w.u64(st.rejectedRecords);
     w.u64(uint64_t(numRegions()));
-    w.data.reserve(w.data.size() + q_.size() * 16);
-    for (double q : q_) w.f64(q);
-    for (uint64_t v : visits_) w.u64(v);
+    w.data.reserve(w.data.size() + table_.qTable().size() * 16);
+    for (double q : table_.qTable()) w.f64(q);
+    for (uint64_t v : table_.visitTable()) w.u64(v);
     if (!fieldio::writeFile(path, w.data, error)) return false;
     return true;
 }
@@ -409,7 +309,7 @@ bool HemiField::load(const std::string& path, std::string* error) {
         return fail("strata " + std::to_string(cols) + "x" + std::to_string(rows) +
                     ", this field has " + std::to_string(params_.cols) + "x" +
                     std::to_string(params_.rows));
-    const size_t count = q_.size();
+    const size_t count = table_.qTable().size();
     if (r.remaining() != count * 16) return fail("table size does not match the header");
     std::vector<double> q(count);
     std::vector<uint64_t> visits(count);
@@ -419,13 +319,8 @@ bool HemiField::load(const std::string& path, std::string* error) {
     }
     for (uint64_t& v : visits) v = r.u64();
     if (!r.ok()) return fail("truncated tables");
-    q_ = std::move(q);
-    visits_ = std::move(visits);
-    for (int region = 0; region < numRegions(); ++region) {
-        buildPolicy(&q_[index(region, 0)], &cdf_[size_t(region) * size_t(strata_ + 1)]);
-        mirrorRegion(region);
-    }
-    stats_ = s;
+    table_.assign(std::move(q), std::move(visits), policy());
+    table_.stats() = s;
     return true;
 }
 

@@ -13,6 +13,7 @@
 
 #include "guiding/directional.h"
 #include "guiding/guiding.h"
+#include "guiding/strata_table.h"
 
 namespace rlpbrt::guiding {
 
@@ -79,38 +80,25 @@ public:
     // Stratum of world direction w in a region's hemisphere, -1 outside.
     int stratumOf(int region, const glm::vec3& w) const;
     // Learned Q and visit count of one stratum.
-    double q(int region, int stratum) const { return q_[index(region, stratum)]; }
-    uint64_t visits(int region, int stratum) const { return visits_[index(region, stratum)]; }
+    double q(int region, int stratum) const { return table_.q(size_t(region))[stratum]; }
+    uint64_t visits(int region, int stratum) const {
+        return table_.visits(size_t(region))[stratum];
+    }
     // Raw tables, for bitwise comparisons: Q, visits, CDFs (n + 1 floats per region).
-    const std::vector<double>& qTable() const { return q_; }
-    const std::vector<uint64_t>& visitTable() const { return visits_; }
-    const std::vector<float>& cdfTable() const { return cdf_; }
+    const std::vector<double>& qTable() const { return table_.qTable(); }
+    const std::vector<uint64_t>& visitTable() const { return table_.visitTable(); }
+    const std::vector<float>& cdfTable() const { return table_.cdfTable(); }
 
 private:
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;
-    // Refreshes the float copy of one region's Q.
-    void mirrorRegion(int region);
-    struct Record {
-        uint32_t region;
-        uint16_t stratum;
-        float target;
-    };
-    struct alignas(64) SlotBuffer {
-        std::vector<Record> records;
-        uint64_t rejectedTargets = 0;
-        uint64_t rejectedRecords = 0;
-    };
     struct KdTree;  // nanoflann index over positions_, defined in hemi.cpp
 
-    size_t index(int region, int stratum) const {
-        return size_t(region) * size_t(strata_) + size_t(stratum);
-    }
     bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
-    const float* cdf(int region) const { return &cdf_[size_t(region) * size_t(strata_ + 1)]; }
-    // Applies one region's records [begin, end) and rebuilds its CDF.
-    void applyRegion(int region, const Record* begin, const Record* end, double* sums,
-                     uint64_t* counts);
+    const float* cdf(int region) const { return table_.cdf(size_t(region)); }
+    StrataTable::PolicyBuilder policy() const {
+        return [this](int, const double* q, float* c) { buildPolicy(q, c); };
+    }
 
     HemiParams params_;
     StrataLayout layout_;
@@ -121,15 +109,8 @@ private:
     std::vector<glm::vec3> positions_;  // one per surface sample
     std::vector<glm::vec3> normals_;    // unit geometric normal per surface sample
     std::unique_ptr<KdTree> tree_;
-    std::vector<double> q_;          // Q per (region, stratum)
-    std::vector<float> qf_;          // Q in float (clamped), read by the per-vertex estimates
+    StrataTable table_;              // Q, float Q, visits, CDFs, record buffers, counters
     std::vector<float> centreX_, centreY_, centreZ_;  // stratum centres (local), per axis
-    std::vector<uint64_t> visits_;   // applied targets per (region, stratum)
-    std::vector<float> cdf_;         // frozen policy: strata_ + 1 entries per region
-    std::vector<SlotBuffer> slots_;  // per-pass record buffers
-    std::vector<uint64_t> regionStart_;  // endPass scratch: counting sort by region
-    std::vector<Record> merged_;         // endPass scratch: records grouped by region
-    GuidingStats stats_;
     uint64_t attempts_ = 0;  // samplePoint calls made at construction
 };
 

@@ -17,7 +17,12 @@ void StrataTable::reset(size_t regions, int strata, double init, const PolicyBui
     qf_.assign(regions * n, float(std::min(init, double(FLT_MAX))));
     visits_.assign(regions * n, 0);
     cdf_.assign(regions * (n + 1), 0.f);
-    for (size_t r = 0; r < regions; ++r) policy(int(r), q(r), &cdf_[r * (n + 1)]);
+    // Every region starts with the same Q: build the first CDF and copy it.
+    if (regions > 0) {
+        policy(0, q(0), cdf_.data());
+        for (size_t r = 1; r < regions; ++r)
+            std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
+    }
     slots_.clear();
     stats_ = GuidingStats();
 }

@@ -1,8 +1,8 @@
 // The learned part of a guiding field, independent of how regions are placed in space: per
 // region a table of strata holding Q (double, and a float copy for the per-vertex estimates),
 // visit counts and the frozen sampling CDF; per-slot record buffers and the deterministic
-// slot-ordered batch merge of Eq. 1 between passes (notes section 4). Used by the vdb backend;
-// standard library and TBB only.
+// slot-ordered batch merge of Eq. 1 between passes (notes section 4). Shared by the hemi and
+// vdb backends; standard library and TBB only.
 #pragma once
 
 #include <cstddef>
@@ -19,7 +19,8 @@ public:
     // Rebuilds one region's CDF (strata + 1 floats) from its Q (strata doubles).
     using PolicyBuilder = std::function<void(int region, const double* q, float* cdf)>;
 
-    // regions x strata entries, every Q = init, no visits; CDFs built with `policy`.
+    // regions x strata entries, every Q = init, no visits; CDFs built with `policy` (which
+    // must depend on Q only: the first region's CDF is copied to all).
     void reset(size_t regions, int strata, double init, const PolicyBuilder& policy);
 
     size_t regions() const { return regions_; }

@@ -348,7 +348,9 @@ TEST(VdbField, SampleReportsPdfOfItsDirection) {
             ASSERT_GT(pdf, 0.f);
             ASSERT_NEAR(glm::length(w), 1.f, 1e-5f);
             float again = f->pdf(1, w);
-            if (again > 0.f) ASSERT_EQ(pdf, again);
+            if (again > 0.f) {
+                ASSERT_EQ(pdf, again);
+            }
         }
         float pdf = 1.f;
         EXPECT_EQ(f->sample(-1, glm::vec2(0.5f), 0.5f, &pdf), glm::vec3(0.f));
@@ -512,7 +514,9 @@ TEST(VdbField, LoadRejectsOtherScenesBackendsAndStructures) {
         std::string err;
         EXPECT_FALSE(f.load(file, &err)) << what;
         EXPECT_NE(err.find(what), std::string::npos) << err;
-        if (auto* v = dynamic_cast<VdbField*>(&f)) EXPECT_EQ(v->cdfTable(), before);
+        if (auto* v = dynamic_cast<VdbField*>(&f)) {
+            EXPECT_EQ(v->cdfTable(), before);
+        }
     };
     // Another scene (bounds differ), same parameters.
     auto other = makeVdb(planeScene(), {{"voxel", "16"}});
