@@ -176,6 +176,13 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
         } else if (key == "dirs") {
             if (value != "hemi" && value != "sphere") return bad(key, value, "hemi or sphere");
             vp->sphere = value == "sphere";
+        } else if (key == "normals") {
+            if (!parseUnsigned(value, 16, &u) || u < 1) return bad(key, value, "an integer in 1..16");
+            vp->normals = int(u);
+        } else if (key == "normal-angle") {
+            if (!parseDouble(value, &d) || !(d > 0.0) || !(d < 180.0))
+                return bad(key, value, "degrees in (0, 180)");
+            vp->normalAngleDeg = d;
         } else if (key == "init") {
             if (!parseDouble(value, &d) || !(d > 0.0) || d > double(FLT_MAX))
                 return bad(key, value, "a positive number <= 3.4e38");
@@ -194,8 +201,8 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             // Consumed by the integrator.
         } else {
             *error = "guiding backend 'vdb': unknown parameter '" + key +
-                     "' (known: alpha, strata, voxel, voxel-size, points, dirs, init, epsilon, "
-                     "cosine, max-mb, mix, target)";
+                     "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
+                     "normal-angle, init, epsilon, cosine, max-mb, mix, target)";
             return false;
         }
     }

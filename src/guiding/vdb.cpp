@@ -70,12 +70,13 @@ double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
     // A flat surface crosses about area / h^2 voxels, an oblique one up to ~3x that.
     const double crossed = 3.0 * std::max(scene.totalArea, 0.0) / (h * h) + 1024.0;
     const double voxels = std::min(points, std::isfinite(crossed) ? crossed : points);
-    const double regionsPerVoxel = params.sphere ? 1.0 : 2.0;
+    // Most voxels hold one surface orientation; edges and corners hold more (counted as 2).
+    const double regionsPerVoxel = params.sphere ? 1.0 : 2.0 * std::min(params.normals, 2);
     const double s = double(params.cols) * params.rows * (params.sphere ? 2.0 : 1.0);
     const double perRegion = s * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) +
                              (s + 1) * sizeof(float) + sizeof(HemiFrame);
-    // Per voxel: its normal and about 8 bytes of OpenVDB tree (leaf values and masks).
-    return voxels * (regionsPerVoxel * perRegion + sizeof(glm::vec3) + 8.0);
+    // Per voxel: normals, offsets and about 8 bytes of OpenVDB tree (leaf values and masks).
+    return voxels * (regionsPerVoxel * (perRegion + sizeof(int)) + 2 * sizeof(glm::vec3) + 12.0);
 }
 
 VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
@@ -87,7 +88,8 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
       voxelSize_(vdbVoxelSize(params, scene)),
       invVoxel_(float(1.0 / voxelSize_)),
       origin_(scene.boundsMin),
-      grid_(std::make_unique<Grid>()) {
+      grid_(std::make_unique<Grid>()),
+      cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * kPi / 180.0))) {
     openvdb::initialize();
     const uint64_t wanted = vdbPointCount(params, scene, voxelSize_);
     openvdb::Int32Grid::Ptr grid = openvdb::Int32Grid::create(-1);
@@ -98,10 +100,18 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     xform->postTranslate(openvdb::Vec3d(origin_.x, origin_.y, origin_.z) + 0.5 * voxelSize_);
     grid->setTransform(xform);
 
-    // Activation: uniform surface samples (Halton sequence through the scene's area sampler);
-    // per voxel a sign-aligned normal sum (aligned with the voxel's first sample).
-    std::vector<glm::dvec3> sums;
-    std::vector<glm::vec3> firsts;
+    // Activation: uniform surface samples (Halton sequence through the scene's area sampler).
+    // Per voxel, the samples' normals are clustered greedily: a sample joins the cluster
+    // whose first normal is closest in angle up to normal-angle (either sign), else opens a
+    // new cluster while the voxel has fewer than `normals`, else joins the closest. A
+    // cluster's normal is the sign-aligned mean of its members.
+    struct Cluster {
+        glm::vec3 first;
+        glm::dvec3 sum;
+    };
+    std::vector<std::vector<Cluster>> clusters;
+    const int maxClusters = params_.sphere ? 1 : params_.normals;
+    const float cosAngle = cosMaxAngle_;
     {
         openvdb::Int32Grid::Accessor acc = grid->getAccessor();
         const uint64_t maxAttempts = 2 * wanted + 64;
@@ -123,28 +133,43 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
             const openvdb::Coord ijk(int(c.x), int(c.y), int(c.z));
             int v = acc.getValue(ijk);
             if (v < 0) {
-                v = int(sums.size());
+                v = int(clusters.size());
                 acc.setValue(ijk, v);
-                sums.emplace_back(0.0);
-                firsts.push_back(n);
+                clusters.emplace_back();
             }
-            sums[size_t(v)] += glm::dvec3(glm::dot(n, firsts[size_t(v)]) >= 0.f ? n : -n);
+            std::vector<Cluster>& cl = clusters[size_t(v)];
+            int best = -1;
+            float bestCos = -1.f;
+            for (size_t k = 0; k < cl.size(); ++k) {
+                float d = std::abs(glm::dot(n, cl[k].first));
+                if (d > bestCos) {
+                    bestCos = d;
+                    best = int(k);
+                }
+            }
+            if (best < 0 || (bestCos < cosAngle && int(cl.size()) < maxClusters)) {
+                cl.push_back(Cluster{n, glm::dvec3(0.0)});
+                best = int(cl.size()) - 1;
+            }
+            Cluster& k = cl[size_t(best)];
+            k.sum += glm::dvec3(glm::dot(n, k.first) >= 0.f ? n : -n);
             ++points_;
         }
     }
     // Renumber the voxels in the tree's order, so that neighbours' tables are close in memory.
-    voxelNormals_.resize(sums.size());
-    int next = 0;
+    clusterStart_.assign(1, 0);
+    clusterNormals_.clear();
     for (auto it = grid->beginValueOn(); it; ++it) {
-        const size_t old = size_t(*it);
-        glm::dvec3 s = sums[old];
-        double l = glm::length(s);
-        voxelNormals_[size_t(next)] = l > 1e-12 ? glm::vec3(s / l) : firsts[old];
-        it.setValue(next++);
+        for (const Cluster& k : clusters[size_t(*it)]) {
+            double l = glm::length(k.sum);
+            clusterNormals_.push_back(l > 1e-12 ? glm::vec3(k.sum / l) : k.first);
+        }
+        it.setValue(int(clusterStart_.size()) - 1);
+        clusterStart_.push_back(uint32_t(clusterNormals_.size()));
     }
     grid_->grid = grid;
     buildFrames();
-    table_.reset(voxelNormals_.size() * (params_.sphere ? 1 : 2),
+    table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
                  layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
 }
 
@@ -152,10 +177,17 @@ VdbField::~VdbField() = default;
 
 void VdbField::buildFrames() {
     frames_.clear();
-    for (const glm::vec3& n : voxelNormals_) {
-        frames_.push_back(HemiFrame::fromZ(n));
-        if (!params_.sphere) frames_.push_back(HemiFrame::fromZ(-n));
-    }
+    regionVoxel_.clear();
+    for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
+        for (uint32_t k = clusterStart_[v]; k < clusterStart_[v + 1]; ++k) {
+            const glm::vec3& n = clusterNormals_[k];
+            frames_.push_back(HemiFrame::fromZ(n));
+            regionVoxel_.push_back(int(v));
+            if (!params_.sphere) {
+                frames_.push_back(HemiFrame::fromZ(-n));
+                regionVoxel_.push_back(int(v));
+            }
+        }
     const int n = layout_.count();
     const int s = params_.sphere ? 2 * n : n;
     centreX_.resize(size_t(s));
@@ -233,7 +265,7 @@ int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
 
 template <class Probe>
 int VdbField::lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) const {
-    if (voxelNormals_.empty() || !finite3(p)) return -1;
+    if (clusterNormals_.empty() || !finite3(p)) return -1;
     if (!params_.sphere && !(glm::dot(n, n) > 0.f)) return -1;
     const glm::vec3 c = glm::floor((p - origin_) * invVoxel_);
     if (!(std::abs(c.x) < kMaxCoord && std::abs(c.y) < kMaxCoord && std::abs(c.z) < kMaxCoord))
@@ -264,7 +296,21 @@ int VdbField::lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) c
         if (v < 0) return -1;
     }
     if (params_.sphere) return v;
-    return 2 * v + (glm::dot(n, voxelNormals_[size_t(v)]) >= 0.f ? 0 : 1);
+    // The voxel's dominant normal closest to n (either side), if within normal-angle.
+    const float threshold = cosMaxAngle_ * glm::length(n);
+    int best = -1;
+    float bestCos = -1.f;
+    bool flip = false;
+    for (uint32_t k = clusterStart_[size_t(v)], e = clusterStart_[size_t(v) + 1]; k < e; ++k) {
+        const float d = glm::dot(n, clusterNormals_[k]);
+        if (std::abs(d) > bestCos) {
+            bestCos = std::abs(d);
+            best = int(k);
+            flip = d < 0.f;
+        }
+    }
+    if (best < 0 || !(bestCos >= threshold)) return -1;
+    return 2 * best + (flip ? 1 : 0);
 }
 
 int VdbField::stratumOf(int region, const glm::vec3& w) const {
@@ -362,7 +408,8 @@ void VdbField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlph
 size_t VdbField::gridBytes() const { return size_t(grid_->grid->memUsage()); }
 
 size_t VdbField::bytes() const {
-    return table_.bytes() + gridBytes() + voxelNormals_.capacity() * sizeof(glm::vec3) +
+    return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
+           clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
            frames_.capacity() * sizeof(HemiFrame) +
            3 * centreX_.capacity() * sizeof(float);
 }
@@ -376,13 +423,13 @@ std::string VdbField::describe() const {
     const GuidingStats& s = table_.stats();
     char buf[640];
     std::snprintf(buf, sizeof(buf),
-                  "vdb: %zu active voxels of %g (from %llu points, %llu draws), %d regions "
-                  "(%s), %dx%d strata, alpha=%s, init=%g, epsilon=%g, cosine=%d, %.1f MiB "
+                  "vdb: %zu active voxels of %g (from %llu points, %llu draws), %zu normals, "
+                  "%d regions (%s), %dx%d strata, alpha=%s, init=%g, epsilon=%g, cosine=%d, %.1f MiB "
                   "(grid %.2f MiB; +%.1f MiB record buffers); passes=%llu, records=%llu, "
                   "rejected targets=%llu, rejected records=%llu",
                   activeVoxels(), voxelSize_, (unsigned long long)points_,
-                  (unsigned long long)attempts_, numRegions(),
-                  params_.sphere ? "full sphere per voxel" : "two hemispheres per voxel",
+                  (unsigned long long)attempts_, clusterCount(), numRegions(),
+                  params_.sphere ? "full sphere per voxel" : "two hemispheres per normal",
                   params_.cols, params_.rows, alpha, params_.init, params_.epsilon,
                   int(params_.cosine && !params_.sphere), double(bytes()) / (1024.0 * 1024.0),
                   double(gridBytes()) / (1024.0 * 1024.0),
@@ -415,8 +462,13 @@ bool VdbField::save(const std::string& path, std::string* error) const {
         copy->insertMeta("rlpbrt:voxel_size", openvdb::DoubleMetadata(voxelSize_));
         copy->insertMeta("rlpbrt:points", openvdb::Int64Metadata(int64_t(points_)));
         copy->insertMeta("rlpbrt:strata", openvdb::Vec2IMetadata(openvdb::Vec2i(params_.cols, params_.rows)));
-        fieldio::Writer normals;
-        for (const glm::vec3& n : voxelNormals_) normals.vec3(n);
+        copy->insertMeta("rlpbrt:normals_max", openvdb::Int32Metadata(params_.normals));
+        copy->insertMeta("rlpbrt:normal_angle", openvdb::DoubleMetadata(params_.normalAngleDeg));
+        fieldio::Writer counts, normals;
+        for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
+            counts.u32(clusterStart_[v + 1] - clusterStart_[v]);
+        for (const glm::vec3& n : clusterNormals_) normals.vec3(n);
+        copy->insertMeta("rlpbrt:clusters", openvdb::StringMetadata(counts.data));
         copy->insertMeta("rlpbrt:normals", openvdb::StringMetadata(normals.data));
         copy->insertMeta("rlpbrt:q", openvdb::StringMetadata(fieldio::packDoubles(table_.qTable())));
         copy->insertMeta("rlpbrt:visits",
@@ -509,6 +561,14 @@ bool VdbField::load(const std::string& path, std::string* error) {
                         " dirs=" + dirs + ", this field has " + std::to_string(params_.cols) +
                         "x" + std::to_string(params_.rows) +
                         " dirs=" + (params_.sphere ? "sphere" : "hemi"));
+        const int normalsMax = grid->metaValue<int32_t>("rlpbrt:normals_max");
+        const double normalAngle = grid->metaValue<double>("rlpbrt:normal_angle");
+        if (!params_.sphere &&
+            (normalsMax != params_.normals || normalAngle != params_.normalAngleDeg))
+            return fail("normals=" + std::to_string(normalsMax) + " normal-angle=" +
+                        std::to_string(normalAngle) + ", this field has normals=" +
+                        std::to_string(params_.normals) +
+                        " normal-angle=" + std::to_string(params_.normalAngleDeg));
         const size_t voxels = size_t(grid->activeVoxelCount());
         std::vector<char> seen(voxels, 0);
         for (auto it = grid->cbeginValueOn(); it; ++it) {
@@ -516,12 +576,27 @@ bool VdbField::load(const std::string& path, std::string* error) {
             if (v < 0 || size_t(v) >= voxels || seen[size_t(v)]) return fail("corrupt voxel indices");
             seen[size_t(v)] = 1;
         }
+        const std::string cblob = grid->metaValue<std::string>("rlpbrt:clusters");
+        if (cblob.size() != voxels * 4) return fail("corrupt cluster table");
+        std::vector<uint32_t> starts(1, 0);
+        fieldio::Reader cr(cblob);
+        for (size_t v = 0; v < voxels; ++v) {
+            const uint32_t c = cr.u32();
+            if (c < 1 || c > uint32_t(params_.sphere ? 1 : params_.normals))
+                return fail("corrupt cluster table");
+            starts.push_back(starts.back() + c);
+        }
+        const size_t count = starts.back();
         const std::string nblob = grid->metaValue<std::string>("rlpbrt:normals");
-        if (nblob.size() != voxels * 12) return fail("corrupt normals table");
-        std::vector<glm::vec3> normals(voxels);
+        if (nblob.size() != count * 12) return fail("corrupt normals table");
+        std::vector<glm::vec3> normals(count);
         fieldio::Reader nr(nblob);
-        for (glm::vec3& n : normals) n = nr.vec3();
-        const size_t regions = voxels * (params_.sphere ? 1 : 2);
+        for (glm::vec3& n : normals) {
+            n = nr.vec3();
+            if (!finite3(n) || std::abs(glm::length(n) - 1.f) > 1e-3f)
+                return fail("corrupt normals table");
+        }
+        const size_t regions = count * (params_.sphere ? 1 : 2);
         const size_t strata = size_t(layout_.count()) * (params_.sphere ? 2 : 1);
         std::vector<double> q;
         std::vector<uint64_t> visits;
@@ -541,7 +616,8 @@ bool VdbField::load(const std::string& path, std::string* error) {
         grid->setName(kGridName);
         grid_->grid = grid;
         grid_->accessors.clear();
-        voxelNormals_ = std::move(normals);
+        clusterStart_ = std::move(starts);
+        clusterNormals_ = std::move(normals);
         buildFrames();
         table_.reset(regions, int(strata), params_.init, policy());
         table_.assign(std::move(q), std::move(visits), policy());

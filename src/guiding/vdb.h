@@ -28,7 +28,9 @@ struct VdbParams {
     double init = 1e-3;
     double epsilon = 0.1;
     bool cosine = true;       // hemisphere tables only: sample in proportion to Q cos(theta)
-    bool sphere = false;      // one full-sphere table per voxel instead of two hemispheres
+    bool sphere = false;      // one full-sphere table per voxel instead of hemispheres
+    int normals = 4;          // at most this many dominant normals (hemisphere pairs) a voxel
+    double normalAngleDeg = 30;  // normal clustering angle and lookup's admissible deviation
 };
 
 // The voxel edge and surface-sample count the parameters give for a scene.
@@ -66,15 +68,17 @@ public:
     const StrataLayout& layout() const { return layout_; }
     double voxelSize() const { return voxelSize_; }
     uint64_t pointCount() const { return points_; }
-    size_t activeVoxels() const { return voxelNormals_.size(); }
+    size_t activeVoxels() const { return clusterStart_.empty() ? 0 : clusterStart_.size() - 1; }
+    // Dominant normals (hemisphere pairs) of all voxels.
+    size_t clusterCount() const { return clusterNormals_.size(); }
     int numRegions() const { return int(table_.regions()); }
     // Strata per region: layout().count(), doubled for full-sphere tables.
     int strataPerRegion() const { return table_.strata(); }
     // Solid angle of one stratum (2 pi / layout().count() in both modes).
     double stratumSolidAngle() const { return layout_.stratumSolidAngle(); }
-    // Voxel of a region and the region's frame (z = the voxel's mean normal, or its
-    // opposite for the second hemisphere).
-    int regionVoxel(int region) const { return params_.sphere ? region : region / 2; }
+    // Voxel of a region and the region's frame (z = one of the voxel's dominant normals, or
+    // its opposite for the second hemisphere).
+    int regionVoxel(int region) const { return regionVoxel_[size_t(region)]; }
     const HemiFrame& regionFrame(int region) const { return frames_[size_t(region)]; }
     // Integer coordinates of the voxel containing p (floor((p - origin) / voxelSize)).
     glm::ivec3 voxelCoord(const glm::vec3& p) const;
@@ -118,8 +122,14 @@ private:
     uint64_t points_ = 0;    // surface samples accepted
     uint64_t attempts_ = 0;  // samplePoint calls
     std::unique_ptr<Grid> grid_;
-    std::vector<glm::vec3> voxelNormals_;  // unit mean normal per active voxel
-    std::vector<HemiFrame> frames_;        // per region
+    float cosMaxAngle_;
+    // Voxel v (the grid's value) owns clusters clusterStart_[v] .. clusterStart_[v + 1] - 1;
+    // cluster k owns regions 2k (around its normal) and 2k + 1 (around the opposite), or
+    // region k for full-sphere tables.
+    std::vector<uint32_t> clusterStart_;
+    std::vector<glm::vec3> clusterNormals_;  // unit dominant normal per cluster
+    std::vector<int> regionVoxel_;          // per region
+    std::vector<HemiFrame> frames_;         // per region
     std::vector<float> centreX_, centreY_, centreZ_;  // local stratum centres (all strata)
     StrataTable table_;
     Accessor accessor_ = Accessor::Hybrid;

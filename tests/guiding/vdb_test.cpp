@@ -155,7 +155,8 @@ TEST(VdbFactory, ParametersAndErrors) {
         {"voxel", "0"},      {"voxel", "4097"},     {"voxel", "1.5"},   {"voxel-size", "0"},
         {"voxel-size", "-1"}, {"voxel-size", "inf"}, {"points", "0"},   {"dirs", "cube"},
         {"init", "0"},       {"epsilon", "2"},      {"cosine", "2"},    {"max-mb", "0"},
-        {"knn", "8"},        {"normal-angle", "30"},
+        {"knn", "8"},        {"normal-angle", "0"}, {"normal-angle", "180"}, {"normals", "0"},
+        {"normals", "17"},
     };
     for (const auto& [key, value] : bad) {
         GuideConfig cfg;
