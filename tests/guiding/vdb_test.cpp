@@ -276,6 +276,35 @@ TEST(VdbField, LookupFindsSurfaceVoxelsAndNothingFarAway) {
     EXPECT_EQ(f->regionVoxel(w), f->voxelIndex(f->voxelCoord(glm::vec3(0.f, 0.53f, 0.53f))));
 }
 
+TEST(VdbField, DominantNormalsPerVoxel) {
+    // Corner voxels (x = 0, z = 0) hold the floor and the wall: two dominant normals.
+    auto f = makeVdb(cornerScene(), {{"voxel", "16"}});
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->clusterCount(), f->activeVoxels() + 16);
+    EXPECT_EQ(f->numRegions(), 2 * int(f->clusterCount()));
+    const glm::vec3 corner(0.01f, 0.5f, 0.f);
+    const int floorUp = f->lookup(corner, glm::vec3(0, 0, 1));
+    const int wallOut = f->lookup(corner, glm::vec3(1, 0, 0));
+    ASSERT_GE(floorUp, 0);
+    ASSERT_GE(wallOut, 0);
+    EXPECT_EQ(f->regionVoxel(floorUp), f->regionVoxel(wallOut));
+    EXPECT_EQ(f->regionFrame(floorUp).n, glm::vec3(0, 0, 1));
+    EXPECT_EQ(f->regionFrame(wallOut).n, glm::vec3(1, 0, 0));
+    EXPECT_EQ(f->regionFrame(f->lookup(corner, glm::vec3(-1, 0, 0))).n, glm::vec3(-1, 0, 0));
+    // A vertex normal more than normal-angle (30 degrees) from every dominant normal: no data.
+    EXPECT_EQ(f->lookup(corner, glm::normalize(glm::vec3(1, 0, 1))), -1);
+    EXPECT_EQ(f->lookup(glm::vec3(0.5f, 0.5f, 0.f), glm::normalize(glm::vec3(1, 0, 0.8f))), -1);
+    EXPECT_GE(f->lookup(glm::vec3(0.5f, 0.5f, 0.f), glm::normalize(glm::vec3(0.4f, 0, 1))), 0);
+    // normals=1: one mean normal per voxel (45 degrees in the corner voxels), and a wider
+    // admissible angle.
+    auto g = makeVdb(cornerScene(), {{"voxel", "16"}, {"normals", "1"}, {"normal-angle", "60"}});
+    ASSERT_TRUE(g);
+    EXPECT_EQ(g->clusterCount(), g->activeVoxels());
+    const int mixed = g->lookup(corner, glm::vec3(0, 0, 1));
+    ASSERT_GE(mixed, 0);
+    EXPECT_NEAR(glm::dot(g->regionFrame(mixed).n, glm::vec3(0, 0, 1)), std::sqrt(0.5f), 0.05f);
+}
+
 TEST(VdbField, AccessorModesGiveTheSameLookups) {
     auto f = makeVdb(cornerScene(), {{"voxel", "16"}});
     ASSERT_TRUE(f);
