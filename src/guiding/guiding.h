@@ -2,7 +2,8 @@
 // queries per vertex (lookup, sample, pdf), feeds with training targets (record) and updates
 // between passes (endPass), after Dahm & Keller 2017, "Learning Light Transport the
 // Reinforced Way". Backends are created by name through createGuidingField, the only place
-// that names them. Depends on the standard library, GLM, TBB and nanoflann only.
+// that names them. Depends on the standard library, GLM, TBB, nanoflann and (in vdb.cpp only)
+// OpenVDB.
 #pragma once
 
 #include <cstddef>
