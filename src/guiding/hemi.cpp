@@ -182,17 +182,7 @@ float HemiField::radiance(int region, const glm::vec3& w) const {
 void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target) {
-    if (!table_.slotOpen(slot)) return;  // no pass open for this slot
-    if (!(target >= 0.f) || !std::isfinite(target)) {
-        table_.rejectTarget(slot);
-        return;
-    }
-    int j = stratumOf(region, w);
-    if (j < 0) {
-        table_.rejectRecord(slot);
-        return;
-    }
-    table_.record(slot, uint32_t(region), j, target);
+    table_.record(slot, region, target, [&] { return stratumOf(region, w); });
 }
 
 void HemiField::buildPolicy(const double* q, float* cdf) const {

@@ -5,6 +5,7 @@
 // vdb backends; standard library and TBB only.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -33,12 +34,25 @@ public:
     // Per-pass record buffers (see GuidingField::beginPass/record).
     void beginPass(int numSlots);
     bool slotOpen(int slot) const { return slot >= 0 && size_t(slot) < slots_.size(); }
-    // The caller validated slot, region and stratum.
-    void record(int slot, uint32_t region, int stratum, float target) {
-        slots_[size_t(slot)].records.push_back(Record{region, uint16_t(stratum), target});
+    // One record of GuidingField::record for a valid region: ignored without an open pass
+    // in `slot`; a target that is negative or not finite is counted as rejected, and so is
+    // a direction outside the region's strata (stratum < 0). `stratum` is called only for
+    // an accepted target.
+    template <class StratumOf>
+    void record(int slot, int region, float target, StratumOf&& stratum) {
+        if (!slotOpen(slot)) return;
+        SlotBuffer& buf = slots_[size_t(slot)];
+        if (!(target >= 0.f) || !std::isfinite(target)) {
+            ++buf.rejectedTargets;
+            return;
+        }
+        const int j = stratum();
+        if (j < 0) {
+            ++buf.rejectedRecords;
+            return;
+        }
+        buf.records.push_back(Record{uint32_t(region), uint16_t(j), target});
     }
-    void rejectTarget(int slot) { ++slots_[size_t(slot)].rejectedTargets; }
-    void rejectRecord(int slot) { ++slots_[size_t(slot)].rejectedRecords; }
     // Applies the records in slot order (running mean if alphaVisits, else fixed alpha) and
     // rebuilds the CDFs of the regions that received records.
     void endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy);

@@ -390,17 +390,7 @@ float VdbField::radiance(int region, const glm::vec3& w) const {
 void VdbField::beginPass(int numSlots) { table_.beginPass(numSlots); }
 
 void VdbField::record(int slot, int region, const glm::vec3& w, float target) {
-    if (!table_.slotOpen(slot)) return;
-    if (!(target >= 0.f) || !std::isfinite(target)) {
-        table_.rejectTarget(slot);
-        return;
-    }
-    int j = stratumOf(region, w);
-    if (j < 0) {
-        table_.rejectRecord(slot);
-        return;
-    }
-    table_.record(slot, uint32_t(region), j, target);
+    table_.record(slot, region, target, [&] { return stratumOf(region, w); });
 }
 
 void VdbField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy()); }
