@@ -268,6 +268,37 @@ TEST(VdbField, DominantNormalsPerVoxel) {
     EXPECT_NEAR(glm::dot(g->regionFrame(mixed).n, glm::vec3(0, 0, 1)), std::sqrt(0.5f), 0.05f);
 }
 
+TEST(VdbField, NoSurfaceGivesEmptyField) {
+    SceneInfo empty = planeScene();
+    empty.samplePoint = [](const glm::vec3&, glm::vec3*, glm::vec3*) { return false; };
+    auto f = makeVdb(empty);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->activeVoxels(), 0u);
+    EXPECT_EQ(f->numRegions(), 0);
+    EXPECT_EQ(f->lookup(glm::vec3(0.5f, 0.5f, 0.f), glm::vec3(0, 0, 1)), -1);
+    f->beginPass(2);
+    f->record(0, 0, glm::vec3(0, 0, 1), 1.f);
+    f->endPass();
+    EXPECT_EQ(f->stats().records, 0u);
+    float pdf = 1.f;
+    EXPECT_EQ(f->sample(0, glm::vec2(0.5f), 0.5f, &pdf), glm::vec3(0.f));
+    EXPECT_EQ(pdf, 0.f);
+    // Degenerate bounds (a single point) still give a finite voxel size.
+    SceneInfo point = planeScene();
+    point.boundsMax = point.boundsMin;
+    point.totalArea = 0.0;
+    point.samplePoint = [](const glm::vec3&, glm::vec3* p, glm::vec3* n) {
+        *p = glm::vec3(0.f);
+        *n = glm::vec3(0, 0, 1);
+        return true;
+    };
+    auto g = makeVdb(point);
+    ASSERT_TRUE(g);
+    EXPECT_TRUE(std::isfinite(g->voxelSize()) && g->voxelSize() > 0.0);
+    EXPECT_EQ(g->activeVoxels(), 1u);
+    EXPECT_GE(g->lookup(glm::vec3(0.f), glm::vec3(0, 0, 1)), 0);
+}
+
 TEST(VdbField, AccessorModesGiveTheSameLookups) {
     auto f = makeVdb(cornerScene(), {{"voxel", "16"}});
     ASSERT_TRUE(f);
