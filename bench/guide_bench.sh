@@ -2,8 +2,8 @@
 # Equal-time comparison of guiding backends against plain path tracing.
 #   bench/guide_bench.sh SECONDS [scene-id ...]     (default: every surface scene)
 # For each scene of ../shared/references/manifest.tsv: renders with --time SECONDS for
-# --guide=none and --guide=hemi (extra rlpbrt options from $ARGS, e.g. ARGS="--guide-param
-# mix=0.3"), and prints spp, relMSE against pbrt-v3's reference, the ratio hemi/none,
+# each backend of $BACKENDS (default "none hemi"; e.g. BACKENDS="none hemi vdb") (extra
+# rlpbrt options from $ARGS, e.g. ARGS="--guide-param mix=0.3"), and prints spp, relMSE against pbrt-v3's reference, the ratio hemi/none,
 # zero-contribution fraction, mean path length and guide memory, as a markdown table.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -21,7 +21,7 @@ tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene 
     [ "$media" = "1" ] && continue
     [ $# -gt 0 ] && [[ "$want" != *" $id "* ]] && continue
     base=""
-    for g in none hemi; do
+    for g in ${BACKENDS:-none hemi}; do
         # shellcheck disable=SC2086
         "$bin" "$shared/scenes/$scene" --time "$secs" --guide "$g" ${ARGS:-} --quiet \
             -o "$tmp/$g.exr" --stats "$tmp/$g.json" > /dev/null 2>&1

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -109,6 +110,20 @@ private:
     int cols_, rows_;
     std::vector<glm::vec3> centres_;
 };
+
+// Radical inverse of i in a prime base: the Halton sequence's coordinate, in [0, 1). Used to
+// draw the surface samples that place regions.
+inline float radicalInverse(uint64_t i, uint64_t base) {
+    const double invBase = 1.0 / static_cast<double>(base);
+    double inv = invBase, value = 0.0;
+    while (i > 0) {
+        uint64_t next = i / base;
+        value += static_cast<double>(i - next * base) * inv;
+        inv *= invBase;
+        i = next;
+    }
+    return std::min(static_cast<float>(value), 0x1.fffffep-1f);
+}
 
 // Builds the CDF of one stratum table: P_j = (1 - epsilon) q_j / sum(q) + epsilon / n, summed
 // in double; uniform if sum(q) is 0 or not finite. cdf has n + 1 entries, cdf[0] = 0 and

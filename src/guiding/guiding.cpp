@@ -3,9 +3,11 @@
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "guiding/hemi.h"
+#include "guiding/vdb.h"
 
 namespace rlpbrt::guiding {
 
@@ -16,6 +18,16 @@ float GuidingField::confidence(int region) const { return region >= 0 ? 1.f : 0.
 float GuidingField::irradianceEstimate(int region, const glm::vec3& n) const {
     return scatteredEstimate(region,
                              [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
+}
+
+bool GuidingField::save(const std::string&, std::string* error) const {
+    *error = "this guiding backend cannot save its field";
+    return false;
+}
+
+bool GuidingField::load(const std::string&, std::string* error) {
+    *error = "this guiding backend cannot load a field";
+    return false;
 }
 
 namespace {
@@ -45,78 +57,141 @@ bool parseUnsigned(const std::string& s, uint64_t maxValue, uint64_t* out) {
     return true;
 }
 
+// The "bad value" message of a backend's parameter; returns false.
+bool badValue(const char* backend, const std::string& key, const std::string& value,
+              const char* expected, std::string* error) {
+    *error = std::string("guiding backend '") + backend + "': bad value '" + value +
+             "' for parameter '" + key + "' (expected " + expected + ")";
+    return false;
+}
+
+// The parameters hemi and vdb share (same names, ranges and members): 1 if `key` is one of
+// them and its value is valid, 0 if it is not a shared key, -1 (and *error) on a bad value.
+template <class Params>
+int parseSharedParam(const char* backend, const std::string& key, const std::string& value,
+                     Params* p, double* maxMiB, std::string* error) {
+    auto bad = [&](const char* expected) {
+        badValue(backend, key, value, expected, error);
+        return -1;
+    };
+    double d = 0.0;
+    uint64_t u = 0;
+    if (key == "alpha") {
+        if (value == "visits") {
+            p->alphaVisits = true;
+        } else if (parseDouble(value, &d) && d > 0.0 && d <= 1.0) {
+            p->alphaVisits = false;
+            p->fixedAlpha = d;
+        } else {
+            return bad("'visits' or a number in (0, 1]");
+        }
+    } else if (key == "strata") {
+        const char* expected = "WxH or N with integers in 1..64";
+        size_t x = value.find_first_of("xX");
+        uint64_t w = 0, h = 0;
+        if (x == std::string::npos) {
+            if (!parseUnsigned(value, 64, &w)) return bad(expected);
+            h = w;
+        } else if (!parseUnsigned(value.substr(0, x), 64, &w) ||
+                   !parseUnsigned(value.substr(x + 1), 64, &h)) {
+            return bad(expected);
+        }
+        if (w < 1 || h < 1) return bad(expected);
+        p->cols = int(w);
+        p->rows = int(h);
+    } else if (key == "points") {
+        if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
+            return bad("an integer in 1..67108864");
+        p->points = u;
+    } else if (key == "normal-angle") {
+        if (!parseDouble(value, &d) || !(d > 0.0) || !(d < 180.0))
+            return bad("degrees in (0, 180)");
+        p->normalAngleDeg = d;
+    } else if (key == "init") {
+        if (!parseDouble(value, &d) || !(d > 0.0) || d > double(FLT_MAX))
+            return bad("a positive number <= 3.4e38");
+        p->init = d;
+    } else if (key == "epsilon") {
+        if (!parseDouble(value, &d) || d < 0.0 || d > 1.0) return bad("a number in [0, 1]");
+        p->epsilon = d;
+    } else if (key == "cosine") {
+        if (value != "0" && value != "1") return bad("0 or 1");
+        p->cosine = value == "1";
+    } else if (key == "max-mb") {
+        if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
+        *maxMiB = d;
+    } else if (key == "mix" || key == "target") {
+        // Consumed by the integrator.
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
 // Reads the hemi parameters; false and *error on an unknown key or a bad value.
 bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParams* hp,
                      double* maxMiB, std::string* error) {
-    auto bad = [&](const std::string& key, const std::string& value, const char* expected) {
-        *error = "guiding backend 'hemi': bad value '" + value + "' for parameter '" + key +
-                 "' (expected " + expected + ")";
-        return false;
-    };
     for (const auto& [key, value] : params) {
-        double d = 0.0;
+        const int shared = parseSharedParam("hemi", key, value, hp, maxMiB, error);
+        if (shared < 0) return false;
+        if (shared > 0) continue;
         uint64_t u = 0;
-        if (key == "alpha") {
-            if (value == "visits") {
-                hp->alphaVisits = true;
-            } else if (parseDouble(value, &d) && d > 0.0 && d <= 1.0) {
-                hp->alphaVisits = false;
-                hp->fixedAlpha = d;
-            } else {
-                return bad(key, value, "'visits' or a number in (0, 1]");
-            }
-        } else if (key == "strata") {
-            const char* expected = "WxH or N with integers in 1..64";
-            size_t x = value.find_first_of("xX");
-            uint64_t w = 0, h = 0;
-            if (x == std::string::npos) {
-                if (!parseUnsigned(value, 64, &w)) return bad(key, value, expected);
-                h = w;
-            } else if (!parseUnsigned(value.substr(0, x), 64, &w) ||
-                       !parseUnsigned(value.substr(x + 1), 64, &h)) {
-                return bad(key, value, expected);
-            }
-            if (w < 1 || h < 1) return bad(key, value, expected);
-            hp->cols = int(w);
-            hp->rows = int(h);
-        } else if (key == "points") {
-            if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
-                return bad(key, value, "an integer in 1..67108864");
-            hp->points = u;
-        } else if (key == "normal-angle") {
-            if (!parseDouble(value, &d) || !(d > 0.0) || !(d < 180.0))
-                return bad(key, value, "degrees in (0, 180)");
-            hp->normalAngleDeg = d;
-        } else if (key == "init") {
-            if (!parseDouble(value, &d) || !(d > 0.0) || d > double(FLT_MAX))
-                return bad(key, value, "a positive number <= 3.4e38");
-            hp->init = d;
-        } else if (key == "epsilon") {
-            if (!parseDouble(value, &d) || d < 0.0 || d > 1.0)
-                return bad(key, value, "a number in [0, 1]");
-            hp->epsilon = d;
-        } else if (key == "knn") {
+        if (key == "knn") {
             if (!parseUnsigned(value, 64, &u) || u < 1)
-                return bad(key, value, "an integer in 1..64");
+                return badValue("hemi", key, value, "an integer in 1..64", error);
             hp->knn = int(u);
         } else if (key == "warmup") {
+            double d = 0.0;
             if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
-                return bad(key, value, "a number in [0, 1e9]");
+                return badValue("hemi", key, value, "a number in [0, 1e9]", error);
             hp->warmup = d;
-        } else if (key == "cosine") {
-            if (value != "0" && value != "1") return bad(key, value, "0 or 1");
-            hp->cosine = value == "1";
-        } else if (key == "max-mb") {
-            if (!parseDouble(value, &d) || !(d > 0.0)) return bad(key, value, "a positive number");
-            *maxMiB = d;
-        } else if (key == "mix" || key == "target") {
-            // Consumed by the integrator.
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
                      "cosine, warmup, max-mb, mix, target)";
             return false;
         }
+    }
+    return true;
+}
+
+// Reads the vdb parameters; false and *error on an unknown key or a bad value.
+bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams* vp,
+                    double* maxMiB, std::string* error) {
+    for (const auto& [key, value] : params) {
+        const int shared = parseSharedParam("vdb", key, value, vp, maxMiB, error);
+        if (shared < 0) return false;
+        if (shared > 0) continue;
+        double d = 0.0;
+        uint64_t u = 0;
+        if (key == "voxel") {
+            if (!parseUnsigned(value, 4096, &u) || u < 1)
+                return badValue("vdb", key, value,
+                                "a voxel count along the longest axis, 1..4096", error);
+            vp->voxelCount = int(u);
+        } else if (key == "voxel-size") {
+            if (!parseDouble(value, &d) || !(d > 0.0))
+                return badValue("vdb", key, value, "a positive voxel edge in world units", error);
+            vp->voxelSize = d;
+        } else if (key == "dirs") {
+            if (value != "hemi" && value != "sphere")
+                return badValue("vdb", key, value, "hemi or sphere", error);
+            vp->sphere = value == "sphere";
+        } else if (key == "normals") {
+            if (!parseUnsigned(value, 16, &u) || u < 1)
+                return badValue("vdb", key, value, "an integer in 1..16", error);
+            vp->normals = int(u);
+        } else {
+            *error = "guiding backend 'vdb': unknown parameter '" + key +
+                     "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
+                     "normal-angle, init, epsilon, cosine, max-mb, mix, target)";
+            return false;
+        }
+    }
+    if (vp->voxelCount > 0 && vp->voxelSize > 0.0) {
+        *error = "guiding backend 'vdb': give 'voxel' (a count) or 'voxel-size' (world units), "
+                 "not both";
+        return false;
     }
     return true;
 }
@@ -149,7 +224,27 @@ std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
         }
         return std::make_unique<HemiField>(hp, scene);
     }
-    *error = "unknown guiding backend '" + config.backend + "' (available: none, hemi)";
+    if (config.backend == "vdb") {
+        VdbParams vp;
+        double maxMiB = 4096.0;
+        if (!parseVdbParams(config.params, &vp, &maxMiB, error)) return nullptr;
+        if (!scene.samplePoint) {
+            *error = "guiding backend 'vdb': the scene provides no surface sampler";
+            return nullptr;
+        }
+        const double mib = vdbEstimatedBytes(vp, scene) / (1024.0 * 1024.0);
+        if (mib > maxMiB) {
+            char buf[256];
+            std::snprintf(buf, sizeof(buf),
+                          "guiding backend 'vdb': voxel size %g with %dx%d strata needs up to "
+                          "about %.0f MiB, more than max-mb=%g",
+                          vdbVoxelSize(vp, scene), vp.cols, vp.rows, mib, maxMiB);
+            *error = buf;
+            return nullptr;
+        }
+        return std::make_unique<VdbField>(vp, scene);
+    }
+    *error = "unknown guiding backend '" + config.backend + "' (available: none, hemi, vdb)";
     return nullptr;
 }
 

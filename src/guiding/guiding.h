@@ -2,7 +2,7 @@
 // queries per vertex (lookup, sample, pdf), feeds with training targets (record) and updates
 // between passes (endPass), after Dahm & Keller 2017, "Learning Light Transport the
 // Reinforced Way". Backends are created by name through createGuidingField, the only place
-// that names them. Depends on the standard library, GLM and TBB only.
+// that names them. Depends on the standard library, GLM, TBB and (in vdb.cpp only) OpenVDB.
 #pragma once
 
 #include <cstddef>
@@ -37,6 +37,7 @@ struct GuidingStats {
     uint64_t records = 0;           // targets applied to the field
     uint64_t rejectedTargets = 0;   // NaN, Inf or negative targets dropped by record()
     uint64_t rejectedRecords = 0;   // bad slot/region or direction outside the hemisphere
+    uint64_t activeVoxels = 0;      // vdb backend: active voxels of the grid (0 otherwise)
 };
 
 // A learned directional distribution per spatial region. lookup/sample/pdf/scattered/
@@ -97,6 +98,15 @@ public:
     virtual std::string describe() const = 0;
     // Learning counters (cumulative).
     virtual GuidingStats stats() const = 0;
+
+    // Saves the learned field (Q, visits, counters and the scene fingerprint) to `path`;
+    // false and *error on failure. Formats: docs/GUIDE_FILES.md. The default: unsupported.
+    virtual bool save(const std::string& path, std::string* error) const;
+    // Replaces the learned state with the one saved in `path` and rebuilds the policy, so a
+    // render starts trained (pdf() equals the saved field's). The file must come from the
+    // same backend, the same scene (bounds, total area) and the same structure (points or
+    // voxel size, strata); otherwise false, *error says why, and the field is unchanged.
+    virtual bool load(const std::string& path, std::string* error);
 };
 
 // The factory: the only place that names backends. "none" returns nullptr with *error empty
@@ -116,6 +126,16 @@ public:
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
 //   mix, target  consumed by the integrator; accepted and ignored here
+// Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.
+// Parameters alpha, strata, init, epsilon, cosine, max-mb, mix, target as hemi, and
+//   voxel        N: N voxels along the longest axis of the scene bounds, 1..4096
+//   voxel-size   the voxel edge in world units, > 0 (not with voxel)
+//                (default for both: the edge that gives about 4096 voxels' worth of surface,
+//                sqrt(totalArea / 4096), clamped to [longest / 1024, longest / 4])
+//   points       surface samples that activate voxels, 1..2^26 (default: 16 per voxel's
+//                worth of surface area, at least 65536, at most 2^24)
+//   dirs         "hemi" (default): two hemispheres per voxel, around its mean normal and its
+//                opposite; "sphere": one full-sphere table per voxel
 std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
                                                  const SceneInfo& scene, std::string* error);
 

@@ -5,25 +5,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "guiding/field_io.h"
 
 namespace rlpbrt::guiding {
 
 namespace {
-
-// Radical inverse of i in a prime base: the Halton sequence's coordinate, in [0, 1).
-float radicalInverse(uint64_t i, uint64_t base) {
-    const double invBase = 1.0 / static_cast<double>(base);
-    double inv = invBase, value = 0.0;
-    while (i > 0) {
-        uint64_t next = i / base;
-        value += static_cast<double>(i - next * base) * inv;
-        inv *= invBase;
-        i = next;
-    }
-    return std::min(static_cast<float>(value), 0x1.fffffep-1f);
-}
 
 bool finite3(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -34,16 +20,19 @@ bool finite3(const glm::vec3& v) {
 double hemiEstimatedBytes(const HemiParams& p) {
     const double n = double(p.cols) * double(p.rows);
     const double perRegion =
-        n * (sizeof(double) + sizeof(uint64_t)) + (n + 1) * sizeof(float) +
+        n * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) + (n + 1) * sizeof(float) +
         64.0;  // RegionFrame
-    // Per point: position, normal, kd-tree index entry and a share of the tree nodes.
-    const double perPoint = 3 * sizeof(glm::vec3) + sizeof(uint32_t) + 8.0;  // + tree copy
+    // Per point: position, normal, the tree's copy, its index entry and a share of the nodes.
+    const double perPoint = 3 * sizeof(glm::vec3) + sizeof(uint32_t) + 8.0;
     return double(p.points) * (2.0 * perRegion + perPoint);
 }
 
 HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     : params_(params),
       layout_(params.cols, params.rows),
+      sceneMin_(scene.boundsMin),
+      sceneMax_(scene.boundsMax),
+      sceneArea_(scene.totalArea),
       strata_(params.cols * params.rows),
       cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * kPi / 180.0))) {
     // Uniform points over the surface: a Halton sequence through the scene's area sampler.
@@ -78,18 +67,11 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     }
     tree_ = std::make_unique<PointKdTree>(positions_);
 
-    const size_t regions = positions_.size() * 2, n = size_t(strata_);
-    q_.assign(regions * n, params.init);
+    const size_t regions = positions_.size() * 2;
     frames_.resize(regions);
     for (size_t r = 0; r < regions; ++r) frames_[r].frame = HemiFrame::fromZ(regionNormal(int(r)));
-    visits_.assign(regions * n, 0);
-    cdf_.resize(regions * (n + 1));
-    if (regions > 0) {
-        buildPolicy(q_.data(), cdf_.data());
-        for (size_t r = 1; r < regions; ++r)
-            std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
-    }
-    for (size_t r = 0; r < regions; ++r) updateMoment(int(r));
+    table_.reset(regions, strata_, params.init, policy());
+    for (size_t r = 0; r < regions; ++r) updateRegion(int(r));
 }
 
 HemiField::~HemiField() = default;
@@ -164,7 +146,7 @@ float HemiField::scatteredEstimate(int region,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (!validRegion(region)) return 0.f;
     const HemiFrame& frame = frames_[size_t(region)].frame;
-    const double* q = &q_[index(region, 0)];
+    const double* q = table_.q(size_t(region));
     double acc = 0.0;
     for (int j = 0; j < strata_; ++j) {
         float f = fcos(frame.toWorld(layout_.centre(j)));
@@ -188,86 +170,37 @@ float HemiField::confidence(int region) const {
 float HemiField::radiance(int region, const glm::vec3& w) const {
     int j = stratumOf(region, w);
     if (j < 0) return 0.f;
-    return static_cast<float>(std::min(q_[index(region, j)], double(FLT_MAX)));
+    return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
 }
 
-void HemiField::beginPass(int numSlots) {
-    numSlots = std::max(numSlots, 0);
-    if (slots_.size() != size_t(numSlots)) slots_.resize(size_t(numSlots));
-    for (SlotBuffer& s : slots_) {
-        s.records.clear();  // keeps the capacity of earlier passes
-        s.rejectedTargets = s.rejectedRecords = 0;
-    }
-}
+void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target) {
-    if (slot < 0 || size_t(slot) >= slots_.size()) return;  // no pass open for this slot
-    SlotBuffer& buf = slots_[size_t(slot)];
-    if (!(target >= 0.f) || !std::isfinite(target)) {
-        ++buf.rejectedTargets;
-        return;
-    }
-    int j = stratumOf(region, w);
-    if (j < 0) {
-        ++buf.rejectedRecords;
-        return;
-    }
-    buf.records.push_back(Record{uint32_t(region), uint16_t(j), target});
+    table_.record(slot, region, target, [&] { return stratumOf(region, w); });
 }
 
-void HemiField::applyRegion(int region, const Record* begin, const Record* end, double* sums,
-                            uint64_t* counts) {
-    std::fill(sums, sums + strata_, 0.0);
-    std::fill(counts, counts + strata_, uint64_t(0));
-    for (const Record* r = begin; r != end; ++r) {  // merge order: slot, then record order
-        sums[r->stratum] += double(r->target);
-        ++counts[r->stratum];
-    }
-    double* q = &q_[index(region, 0)];
-    uint64_t* visits = &visits_[index(region, 0)];
-    for (int j = 0; j < strata_; ++j) {
-        const uint64_t m = counts[j];
-        if (m == 0) continue;
-        const double mean = sums[j] / double(m);
-        double updated;
-        if (params_.alphaVisits) {
-            // m sequential updates with alpha = 1/(1 + visits): the running mean of all targets.
-            const double nOld = double(visits[j]);
-            updated = (nOld * q[j] + sums[j]) / (nOld + double(m));
-        } else {
-            // m updates with a fixed alpha and the batch mean as target: keep (1 - alpha)^m.
-            const double keep = std::exp(double(m) * std::log1p(-params_.fixedAlpha));
-            updated = keep * q[j] + (1.0 - keep) * mean;
-        }
-        // Both are convex combinations of finite non-negative values; guard regardless.
-        q[j] = (std::isfinite(updated) && updated >= 0.0) ? updated : mean;
-        visits[j] += m;
-    }
-    buildPolicy(q, &cdf_[size_t(region) * size_t(strata_ + 1)]);
-    updateMoment(region);
-}
-
-void HemiField::updateMoment(int region) {
-    const double* q = &q_[index(region, 0)];
-    double m[3] = {0.0, 0.0, 0.0};
+void HemiField::updateRegion(int region) {
+    const double* q = table_.q(size_t(region));
+    const uint64_t* visitCounts = table_.visits(size_t(region));
+    double m[3] = {0.0, 0.0, 0.0}, visits = 0.0;
     for (int j = 0; j < strata_; ++j) {
         const glm::vec3& c = layout_.centre(j);
         m[0] += q[j] * double(c.x);
         m[1] += q[j] * double(c.y);
         m[2] += q[j] * double(c.z);
+        visits += double(visitCounts[j]);
     }
-    double visits = 0.0;
-    for (int j = 0; j < strata_; ++j) visits += double(visits_[index(region, j)]);
+    RegionFrame& rf = frames_[size_t(region)];
     const double w = params_.warmup * double(strata_);
-    frames_[size_t(region)].confidence = w > 0.0 ? float(visits / (visits + w)) : 1.f;
+    rf.confidence = w > 0.0 ? float(visits / (visits + w)) : 1.f;
     const double sa = layout_.stratumSolidAngle();
-    const HemiFrame& f = frames_[size_t(region)].frame;
+    const HemiFrame& f = rf.frame;
     glm::vec3 world;
     for (int i = 0; i < 3; ++i) {
         double v = (double(f.s[i]) * m[0] + double(f.t[i]) * m[1] + double(f.n[i]) * m[2]) * sa;
         world[i] = float(std::max(-double(FLT_MAX), std::min(v, double(FLT_MAX))));
     }
-    frames_[size_t(region)].moment = finite3(world) ? world : glm::vec3(0.f);
+    rf.moment = finite3(world) ? world : glm::vec3(0.f);
 }
 
 void HemiField::buildPolicy(const double* q, float* cdf) const {
@@ -280,59 +213,14 @@ void HemiField::buildPolicy(const double* q, float* cdf) const {
     buildStrataCdf(qc, strata_, params_.epsilon, cdf);
 }
 
-void HemiField::endPass() {
-    const size_t regions = size_t(numRegions());
-    uint64_t total = 0;
-    for (const SlotBuffer& s : slots_) {
-        total += s.records.size();
-        stats_.rejectedTargets += s.rejectedTargets;
-        stats_.rejectedRecords += s.rejectedRecords;
-    }
-    ++stats_.passes;
-    stats_.records += total;
-    if (total > 0 && regions > 0) {
-        // Stable counting sort by region: within a region, records stay in slot order.
-        regionStart_.assign(regions + 1, 0);
-        for (const SlotBuffer& s : slots_)
-            for (const Record& r : s.records) ++regionStart_[r.region + 1];
-        for (size_t r = 0; r < regions; ++r) regionStart_[r + 1] += regionStart_[r];
-        merged_.resize(total);
-        for (const SlotBuffer& s : slots_)
-            for (const Record& r : s.records) merged_[regionStart_[r.region]++] = r;
-        // regionStart_[r] now holds the end of region r, i.e. the start of region r + 1.
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 256),
-                          [&](const tbb::blocked_range<size_t>& range) {
-                              std::vector<double> sums(static_cast<size_t>(strata_));
-                              std::vector<uint64_t> counts(static_cast<size_t>(strata_));
-                              for (size_t r = range.begin(); r != range.end(); ++r) {
-                                  size_t b = r == 0 ? 0 : regionStart_[r - 1];
-                                  size_t e = regionStart_[r];
-                                  if (b == e) continue;
-                                  applyRegion(int(r), merged_.data() + b, merged_.data() + e,
-                                              sums.data(), counts.data());
-                              }
-                          });
-    }
-    for (SlotBuffer& s : slots_) {
-        s.records.clear();
-        s.rejectedTargets = s.rejectedRecords = 0;
-    }
-}
+void HemiField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy()); }
 
 size_t HemiField::bytes() const {
-    size_t b = q_.capacity() * sizeof(double) + frames_.capacity() * sizeof(RegionFrame) +
-               visits_.capacity() * sizeof(uint64_t) +
-               cdf_.capacity() * sizeof(float) +
-               (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3);
-    b += tree_->bytes();
-    return b;
+    return table_.bytes() + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
+           frames_.capacity() * sizeof(RegionFrame) + tree_->bytes();
 }
 
-size_t HemiField::scratchBytes() const {
-    size_t b = merged_.capacity() * sizeof(Record) + regionStart_.capacity() * sizeof(uint64_t);
-    for (const SlotBuffer& s : slots_) b += s.records.capacity() * sizeof(Record);
-    return b;
-}
+size_t HemiField::scratchBytes() const { return table_.scratchBytes(); }
 
 std::string HemiField::describe() const {
     char alpha[32];
@@ -350,12 +238,95 @@ std::string HemiField::describe() const {
                   params_.rows, alpha, params_.normalAngleDeg, params_.knn, params_.init,
                   params_.epsilon, double(bytes()) / (1024.0 * 1024.0),
                   double(scratchBytes()) / (1024.0 * 1024.0),
-                  (unsigned long long)stats_.passes, (unsigned long long)stats_.records,
-                  (unsigned long long)stats_.rejectedTargets,
-                  (unsigned long long)stats_.rejectedRecords);
+                  (unsigned long long)stats().passes, (unsigned long long)stats().records,
+                  (unsigned long long)stats().rejectedTargets,
+                  (unsigned long long)stats().rejectedRecords);
     return buf;
 }
 
-GuidingStats HemiField::stats() const { return stats_; }
+GuidingStats HemiField::stats() const { return table_.stats(); }
+
+bool HemiField::save(const std::string& path, std::string* error) const {
+    fieldio::Writer w;
+    w.raw(fieldio::kMagic, 8);
+    w.u32(fieldio::kVersion);
+    w.str("hemi");
+    w.vec3(sceneMin_);
+    w.vec3(sceneMax_);
+    w.f64(sceneArea_);
+    w.u64(positions_.size());
+    w.u64(attempts_);
+    w.u32(uint32_t(params_.cols));
+    w.u32(uint32_t(params_.rows));
+    const GuidingStats& st = table_.stats();
+    w.u64(st.passes);
+    w.u64(st.records);
+    w.u64(st.rejectedTargets);
+    w.u64(st.rejectedRecords);
+    w.u64(uint64_t(numRegions()));
+    w.data.reserve(w.data.size() + table_.qTable().size() * 16);
+    for (double q : table_.qTable()) w.f64(q);
+    for (uint64_t v : table_.visitTable()) w.u64(v);
+    if (!fieldio::writeFile(path, w.data, error)) return false;
+    return true;
+}
+
+bool HemiField::load(const std::string& path, std::string* error) {
+    const std::string kind = fieldio::fileKind(path);
+    if (kind.empty()) {
+        *error = "'" + path + "' is not a saved guiding field (or cannot be read)";
+        return false;
+    }
+    if (kind != "hemi") {
+        *error = "'" + path + "' holds a '" + kind +
+                 "' guiding field; the hemi backend loads only fields it saved";
+        return false;
+    }
+    std::string data;
+    if (!fieldio::readFile(path, &data, error)) return false;
+    auto fail = [&](const std::string& why) {
+        *error = "'" + path + "': " + why;
+        return false;
+    };
+    fieldio::Reader r(data);
+    r.skip(8);
+    const uint32_t version = r.u32();
+    r.str();
+    if (version != fieldio::kVersion) return fail("unsupported version " + std::to_string(version));
+    const glm::vec3 bmin = r.vec3(), bmax = r.vec3();
+    const double area = r.f64();
+    const uint64_t points = r.u64(), attempts = r.u64();
+    const uint32_t cols = r.u32(), rows = r.u32();
+    GuidingStats s;
+    s.passes = r.u64();
+    s.records = r.u64();
+    s.rejectedTargets = r.u64();
+    s.rejectedRecords = r.u64();
+    const uint64_t regions = r.u64();
+    if (!r.ok()) return fail("truncated header");
+    std::string why;
+    if (!fieldio::sameScene(bmin, bmax, area, sceneMin_, sceneMax_, sceneArea_, &why))
+        return fail(why);
+    if (points != positions_.size() || attempts != attempts_ || regions != uint64_t(numRegions()))
+        return fail("made with " + std::to_string(points) + " points, this field has " +
+                    std::to_string(positions_.size()) + " (use the same points parameter)");
+    if (int(cols) != params_.cols || int(rows) != params_.rows)
+        return fail("strata " + std::to_string(cols) + "x" + std::to_string(rows) +
+                    ", this field has " + std::to_string(params_.cols) + "x" +
+                    std::to_string(params_.rows));
+    const size_t count = table_.qTable().size();
+    if (r.remaining() != count * 16) return fail("table size does not match the header");
+    std::vector<double> q(count);
+    std::vector<uint64_t> visits(count);
+    for (double& d : q) {
+        d = r.f64();
+        if (!(d >= 0.0) || !std::isfinite(d)) return fail("corrupt Q table");
+    }
+    for (uint64_t& v : visits) v = r.u64();
+    if (!r.ok()) return fail("truncated tables");
+    table_.assign(std::move(q), std::move(visits), policy());
+    table_.stats() = s;
+    return true;
+}
 
 }  // namespace rlpbrt::guiding

@@ -14,6 +14,7 @@
 #include "guiding/directional.h"
 #include "guiding/guiding.h"
 #include "guiding/kdtree.h"
+#include "guiding/strata_table.h"
 
 namespace rlpbrt::guiding {
 
@@ -66,6 +67,9 @@ public:
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;
+    // Little-endian binary file, docs/GUIDE_FILES.md.
+    bool save(const std::string& path, std::string* error) const override;
+    bool load(const std::string& path, std::string* error) override;
 
     // Inspection (tests, tools).
     // Bytes of the per-pass record buffers and endPass scratch (not counted in bytes()).
@@ -83,49 +87,44 @@ public:
     // Stratum of world direction w in a region's hemisphere, -1 outside.
     int stratumOf(int region, const glm::vec3& w) const;
     // Learned Q and visit count of one stratum.
-    double q(int region, int stratum) const { return q_[index(region, stratum)]; }
-    uint64_t visits(int region, int stratum) const { return visits_[index(region, stratum)]; }
+    double q(int region, int stratum) const { return table_.q(size_t(region))[stratum]; }
+    uint64_t visits(int region, int stratum) const {
+        return table_.visits(size_t(region))[stratum];
+    }
     // Raw tables, for bitwise comparisons: Q, visits, CDFs (n + 1 floats per region).
-    const std::vector<double>& qTable() const { return q_; }
-    const std::vector<uint64_t>& visitTable() const { return visits_; }
-    const std::vector<float>& cdfTable() const { return cdf_; }
+    const std::vector<double>& qTable() const { return table_.qTable(); }
+    const std::vector<uint64_t>& visitTable() const { return table_.visitTable(); }
+    const std::vector<float>& cdfTable() const { return table_.cdfTable(); }
 
 private:
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;
-    // Refreshes the irradiance moment of one region from its Q.
-    void updateMoment(int region);
-    struct Record {
-        uint32_t region;
-        uint16_t stratum;
-        float target;
-    };
-    struct alignas(64) SlotBuffer {
-        std::vector<Record> records;
-        uint64_t rejectedTargets = 0;
-        uint64_t rejectedRecords = 0;
-    };
-
-    size_t index(int region, int stratum) const {
-        return size_t(region) * size_t(strata_) + size_t(stratum);
-    }
-    bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
-    const float* cdf(int region) const { return &cdf_[size_t(region) * size_t(strata_ + 1)]; }
     // Starts loading the data the per-vertex queries read for a region; returns region.
     int prefetched(int region) const;
-    // Applies one region's records [begin, end) and rebuilds its CDF.
-    void applyRegion(int region, const Record* begin, const Record* end, double* sums,
-                     uint64_t* counts);
+    // Refreshes a region's moment and confidence from its Q and visits (after a CDF build).
+    void updateRegion(int region);
+
+    bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
+    const float* cdf(int region) const { return table_.cdf(size_t(region)); }
+    // Rebuilds a region's CDF, then its moment and confidence (called per updated region,
+    // concurrently for distinct regions).
+    StrataTable::PolicyBuilder policy() {
+        return [this](int region, const double* q, float* c) {
+            buildPolicy(q, c);
+            if (size_t(region) < frames_.size()) updateRegion(region);
+        };
+    }
 
     HemiParams params_;
     StrataLayout layout_;
+    glm::vec3 sceneMin_, sceneMax_;  // the scene fingerprint of saved fields
+    double sceneArea_;
     int strata_;
     float cosMaxAngle_;
     std::vector<glm::vec3> positions_;  // one per surface sample
     std::vector<glm::vec3> normals_;    // unit geometric normal per surface sample
     std::unique_ptr<PointKdTree> tree_;
-    std::vector<double> q_;          // Q per (region, stratum)
-    // Per region, one cache line: the frame of its hemisphere (z = normal) and the moment
+    // Per region, one cache line: the frame of its hemisphere (z = normal), the moment
     // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, and its confidence.
     struct alignas(64) RegionFrame {
         HemiFrame frame;
@@ -133,12 +132,7 @@ private:
         float confidence = 0.f;  // visits / (visits + warmup * strata), frozen per pass
     };
     std::vector<RegionFrame> frames_;
-    std::vector<uint64_t> visits_;   // applied targets per (region, stratum)
-    std::vector<float> cdf_;         // frozen policy: strata_ + 1 entries per region
-    std::vector<SlotBuffer> slots_;  // per-pass record buffers
-    std::vector<uint64_t> regionStart_;  // endPass scratch: counting sort by region
-    std::vector<Record> merged_;         // endPass scratch: records grouped by region
-    GuidingStats stats_;
+    StrataTable table_;              // Q, float Q, visits, CDFs, record buffers, counters
     uint64_t attempts_ = 0;  // samplePoint calls made at construction
 };
 

@@ -63,6 +63,7 @@ std::string defaultOutput(const Scene& scene) {
 int main(int argc, char** argv) {
     CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
     std::string scenePath, outFile, statsFile, guide = "none", curveFile, refFile;
+    std::string guideSave, guideLoad;
     bool parseOnly = false, quiet = false;
     int spp = 0, nThreads = 0;
     double timeBudget = 0.0;
@@ -80,11 +81,14 @@ int main(int argc, char** argv) {
     app.add_option("--seed", seed, "random seed");
     app.add_flag("--quiet,-q", quiet, "no progress or summary output");
     std::vector<std::string> guideParams;
-    app.add_option("--guide", guide, "guiding backend: none or hemi")
-        ->check(CLI::IsMember({"none", "hemi"}));
+    app.add_option("--guide", guide, "guiding backend: none, hemi or vdb")
+        ->check(CLI::IsMember({"none", "hemi", "vdb"}));
     app.add_option("--guide-param", guideParams,
                    "guiding parameter key=value (repeatable): mix, alpha, strata (WxH), "
-                   "points, normal-angle, init, epsilon, knn");
+                   "points, normal-angle, init, epsilon, knn; vdb: voxel, voxel-size, dirs");
+    app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering");
+    app.add_option("--guide-load", guideLoad,
+                   "start from a guiding field saved for this scene with the same backend");
     app.add_option("--stats", statsFile, "write run statistics as JSON");
     auto* refOpt = app.add_option("--ref", refFile, "reference image for --curve (same size as "
                                                     "the film's output)");
@@ -147,6 +151,14 @@ int main(int argc, char** argv) {
         double tg = seconds();
         if (!setupGuiding(*scene, gc, &field, &guideSettings, &gerr)) {
             std::fprintf(stderr, "error: --guide=%s: %s\n", guide.c_str(), gerr.c_str());
+            return 1;
+        }
+        if (!field && (!guideLoad.empty() || !guideSave.empty())) {
+            std::fprintf(stderr, "error: --guide-load/--guide-save need a guiding backend\n");
+            return 1;
+        }
+        if (!guideLoad.empty() && !field->load(guideLoad, &gerr)) {
+            std::fprintf(stderr, "error: --guide-load: %s\n", gerr.c_str());
             return 1;
         }
         if (field && !quiet)
@@ -224,6 +236,12 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
+    if (!guideSave.empty()) {
+        if (!field->save(guideSave, &err)) {
+            std::fprintf(stderr, "error: --guide-save: %s\n", err.c_str());
+            return 1;
+        }
+    }
     if (r.stats.nonFinite > 0)
         std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n",
                      (unsigned long long)r.stats.nonFinite);
@@ -245,6 +263,7 @@ int main(int argc, char** argv) {
             j["guide_records"] = gs.records;
             j["guide_rejected_targets"] = gs.rejectedTargets;
             j["guide_mix"] = mix;
+            if (guide == "vdb") j["guide_active_voxels"] = gs.activeVoxels;
         }
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;

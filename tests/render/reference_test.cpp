@@ -1,6 +1,7 @@
 // Correctness against pbrt-v3: every scene of ../shared/references/manifest.tsv (surface
 // scenes, and the media=1 scenes rendered with volpath semantics) is rendered at 64 spp
-// (fixed seed) with --guide=none and hemi and compared with pbrt-v3's reference.
+// (fixed seed) with every guiding backend (none, hemi, vdb) and compared with pbrt-v3's
+// reference.
 // Bounds (issue "path tracer" acceptance): relMSE <= 1.5x pbrt-v3's own 64-spp relMSE;
 // median block deviation <= max(2%, 1.5x pbrt-v3's own 64-spp figure); no NaN/Inf.
 #include <fstream>
@@ -55,7 +56,7 @@ const char* kSurfaceScenes[] = {
 };
 
 // Every backend must pass the same test: guiding changes the noise, never the expectation.
-const char* kGuides[] = {"none", "hemi"};
+const char* kGuides[] = {"none", "hemi", "vdb"};
 
 // The scenes with participating media (manifest media=1): the same test, same bounds.
 const char* kMediaScenes[] = {"cloud__cloud"};

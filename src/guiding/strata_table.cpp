@@ -1,0 +1,137 @@
+#include "guiding/strata_table.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace rlpbrt::guiding {
+
+void StrataTable::reset(size_t regions, int strata, double init, const PolicyBuilder& policy) {
+    regions_ = regions;
+    strata_ = strata;
+    const size_t n = size_t(strata);
+    q_.assign(regions * n, init);
+    qf_.assign(regions * n, float(std::min(init, double(FLT_MAX))));
+    visits_.assign(regions * n, 0);
+    cdf_.assign(regions * (n + 1), 0.f);
+    // Every region starts with the same Q: build the first CDF and copy it.
+    if (regions > 0) {
+        policy(0, q(0), cdf_.data());
+        for (size_t r = 1; r < regions; ++r)
+            std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
+    }
+    slots_.clear();
+    stats_ = GuidingStats();
+}
+
+void StrataTable::assign(std::vector<double> q, std::vector<uint64_t> visits,
+                         const PolicyBuilder& policy) {
+    q_ = std::move(q);
+    visits_ = std::move(visits);
+    for (size_t r = 0; r < regions_; ++r) {
+        policy(int(r), this->q(r), &cdf_[r * size_t(strata_ + 1)]);
+        mirror(r);
+    }
+}
+
+void StrataTable::beginPass(int numSlots) {
+    numSlots = std::max(numSlots, 0);
+    if (slots_.size() != size_t(numSlots)) slots_.resize(size_t(numSlots));
+    for (SlotBuffer& s : slots_) {
+        s.records.clear();  // keeps the capacity of earlier passes
+        s.rejectedTargets = s.rejectedRecords = 0;
+    }
+}
+
+void StrataTable::mirror(size_t region) {
+    const double* qd = &q_[region * size_t(strata_)];
+    float* qs = &qf_[region * size_t(strata_)];
+    for (int j = 0; j < strata_; ++j) qs[j] = float(std::min(qd[j], double(FLT_MAX)));
+}
+
+void StrataTable::applyRegion(size_t region, const Record* begin, const Record* end,
+                              bool alphaVisits, double fixedAlpha, double* sums,
+                              uint64_t* counts, const PolicyBuilder& policy) {
+    std::fill(sums, sums + strata_, 0.0);
+    std::fill(counts, counts + strata_, uint64_t(0));
+    for (const Record* r = begin; r != end; ++r) {  // merge order: slot, then record order
+        sums[r->stratum] += double(r->target);
+        ++counts[r->stratum];
+    }
+    double* q = &q_[region * size_t(strata_)];
+    uint64_t* visits = &visits_[region * size_t(strata_)];
+    for (int j = 0; j < strata_; ++j) {
+        const uint64_t m = counts[j];
+        if (m == 0) continue;
+        const double mean = sums[j] / double(m);
+        double updated;
+        if (alphaVisits) {
+            // m sequential updates with alpha = 1/(1 + visits): the running mean of all targets.
+            const double nOld = double(visits[j]);
+            updated = (nOld * q[j] + sums[j]) / (nOld + double(m));
+        } else {
+            // m updates with a fixed alpha and the batch mean as target: keep (1 - alpha)^m.
+            const double keep = std::exp(double(m) * std::log1p(-fixedAlpha));
+            updated = keep * q[j] + (1.0 - keep) * mean;
+        }
+        q[j] = (std::isfinite(updated) && updated >= 0.0) ? updated : mean;
+        visits[j] += m;
+    }
+    policy(int(region), q, &cdf_[region * size_t(strata_ + 1)]);
+    mirror(region);
+}
+
+void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy) {
+    uint64_t total = 0;
+    for (const SlotBuffer& s : slots_) {
+        total += s.records.size();
+        stats_.rejectedTargets += s.rejectedTargets;
+        stats_.rejectedRecords += s.rejectedRecords;
+    }
+    ++stats_.passes;
+    stats_.records += total;
+    if (total > 0 && regions_ > 0) {
+        // Stable counting sort by region: within a region, records stay in slot order.
+        regionStart_.assign(regions_ + 1, 0);
+        for (const SlotBuffer& s : slots_)
+            for (const Record& r : s.records) ++regionStart_[r.region + 1];
+        for (size_t r = 0; r < regions_; ++r) regionStart_[r + 1] += regionStart_[r];
+        merged_.resize(total);
+        for (const SlotBuffer& s : slots_)
+            for (const Record& r : s.records) merged_[regionStart_[r.region]++] = r;
+        // regionStart_[r] now holds the end of region r.
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, regions_, 256),
+                          [&](const tbb::blocked_range<size_t>& range) {
+                              std::vector<double> sums(static_cast<size_t>(strata_));
+                              std::vector<uint64_t> counts(static_cast<size_t>(strata_));
+                              for (size_t r = range.begin(); r != range.end(); ++r) {
+                                  size_t b = r == 0 ? 0 : regionStart_[r - 1];
+                                  size_t e = regionStart_[r];
+                                  if (b == e) continue;
+                                  applyRegion(r, merged_.data() + b, merged_.data() + e,
+                                              alphaVisits, fixedAlpha, sums.data(),
+                                              counts.data(), policy);
+                              }
+                          });
+    }
+    for (SlotBuffer& s : slots_) {
+        s.records.clear();
+        s.rejectedTargets = s.rejectedRecords = 0;
+    }
+}
+
+size_t StrataTable::bytes() const {
+    return q_.capacity() * sizeof(double) + qf_.capacity() * sizeof(float) +
+           visits_.capacity() * sizeof(uint64_t) + cdf_.capacity() * sizeof(float);
+}
+
+size_t StrataTable::scratchBytes() const {
+    size_t b = merged_.capacity() * sizeof(Record) + regionStart_.capacity() * sizeof(uint64_t);
+    for (const SlotBuffer& s : slots_) b += s.records.capacity() * sizeof(Record);
+    return b;
+}
+
+}  // namespace rlpbrt::guiding

@@ -1,0 +1,102 @@
+// The learned part of a guiding field, independent of how regions are placed in space: per
+// region a table of strata holding Q (double, and a float copy for the per-vertex estimates),
+// visit counts and the frozen sampling CDF; per-slot record buffers and the deterministic
+// slot-ordered batch merge of Eq. 1 between passes (notes section 4). Shared by the hemi and
+// vdb backends; standard library and TBB only.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "guiding/guiding.h"
+
+namespace rlpbrt::guiding {
+
+class StrataTable {
+public:
+    // Rebuilds one region's CDF (strata + 1 floats) from its Q (strata doubles).
+    using PolicyBuilder = std::function<void(int region, const double* q, float* cdf)>;
+
+    // regions x strata entries, every Q = init, no visits; CDFs built with `policy` (which
+    // must depend on Q only: the first region's CDF is copied to all).
+    void reset(size_t regions, int strata, double init, const PolicyBuilder& policy);
+
+    size_t regions() const { return regions_; }
+    int strata() const { return strata_; }
+    const double* q(size_t region) const { return &q_[region * size_t(strata_)]; }
+    const float* qf(size_t region) const { return &qf_[region * size_t(strata_)]; }
+    const uint64_t* visits(size_t region) const { return &visits_[region * size_t(strata_)]; }
+    const float* cdf(size_t region) const { return &cdf_[region * size_t(strata_ + 1)]; }
+
+    // Per-pass record buffers (see GuidingField::beginPass/record).
+    void beginPass(int numSlots);
+    bool slotOpen(int slot) const { return slot >= 0 && size_t(slot) < slots_.size(); }
+    // One record of GuidingField::record for a valid region: ignored without an open pass
+    // in `slot`; a target that is negative or not finite is counted as rejected, and so is
+    // a direction outside the region's strata (stratum < 0). `stratum` is called only for
+    // an accepted target.
+    template <class StratumOf>
+    void record(int slot, int region, float target, StratumOf&& stratum) {
+        if (!slotOpen(slot)) return;
+        SlotBuffer& buf = slots_[size_t(slot)];
+        if (!(target >= 0.f) || !std::isfinite(target)) {
+            ++buf.rejectedTargets;
+            return;
+        }
+        const int j = stratum();
+        if (j < 0) {
+            ++buf.rejectedRecords;
+            return;
+        }
+        buf.records.push_back(Record{uint32_t(region), uint16_t(j), target});
+    }
+    // Applies the records in slot order (running mean if alphaVisits, else fixed alpha) and
+    // rebuilds the CDFs of the regions that received records.
+    void endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy);
+
+    // Replaces Q and visits (same sizes; checked by the caller) and rebuilds every CDF.
+    void assign(std::vector<double> q, std::vector<uint64_t> visits,
+                const PolicyBuilder& policy);
+
+    const std::vector<double>& qTable() const { return q_; }
+    const std::vector<uint64_t>& visitTable() const { return visits_; }
+    const std::vector<float>& cdfTable() const { return cdf_; }
+    GuidingStats& stats() { return stats_; }
+    const GuidingStats& stats() const { return stats_; }
+
+    // Learned data (Q, float Q, visits, CDFs) and per-pass scratch, in bytes.
+    size_t bytes() const;
+    size_t scratchBytes() const;
+
+private:
+    struct Record {
+        uint32_t region;
+        uint16_t stratum;
+        float target;
+    };
+    struct alignas(64) SlotBuffer {
+        std::vector<Record> records;
+        uint64_t rejectedTargets = 0;
+        uint64_t rejectedRecords = 0;
+    };
+    void applyRegion(size_t region, const Record* begin, const Record* end, bool alphaVisits,
+                     double fixedAlpha, double* sums, uint64_t* counts,
+                     const PolicyBuilder& policy);
+    void mirror(size_t region);
+
+    size_t regions_ = 0;
+    int strata_ = 0;
+    std::vector<double> q_;
+    std::vector<float> qf_;
+    std::vector<uint64_t> visits_;
+    std::vector<float> cdf_;
+    std::vector<SlotBuffer> slots_;
+    std::vector<uint64_t> regionStart_;
+    std::vector<Record> merged_;
+    GuidingStats stats_;
+};
+
+}  // namespace rlpbrt::guiding

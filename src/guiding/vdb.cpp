@@ -1,0 +1,621 @@
+#include "guiding/vdb.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tree/ValueAccessor.h>
+#include <tbb/enumerable_thread_specific.h>
+
+#include "guiding/field_io.h"
+
+namespace rlpbrt::guiding {
+
+namespace {
+
+bool finite3(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+float longestAxis(const SceneInfo& scene) {
+    glm::vec3 d = scene.boundsMax - scene.boundsMin;
+    float l = std::max(d.x, std::max(d.y, d.z));
+    return std::isfinite(l) && l > 0.f ? l : 0.f;
+}
+
+// Coordinates beyond this are treated as outside every grid (and stay far from int overflow
+// when the 26 neighbours are formed).
+constexpr float kMaxCoord = float(1 << 30);
+
+constexpr const char* kGridName = "rlpbrt_regions";
+constexpr int kFileVersion = 1;
+
+// A non-registering accessor: cheap to construct per lookup, read-only, no locking.
+using ConstAccessor = openvdb::tree::ValueAccessor<const openvdb::Int32Tree, false>;
+
+}  // namespace
+
+struct VdbField::Grid {
+    openvdb::Int32Grid::Ptr grid;
+    // Per-thread accessors (Accessor::PerThread), created on first use by each thread.
+    mutable tbb::enumerable_thread_specific<std::unique_ptr<ConstAccessor>> accessors;
+};
+
+double vdbVoxelSize(const VdbParams& params, const SceneInfo& scene) {
+    if (params.voxelSize > 0.0) return params.voxelSize;
+    const double longest = longestAxis(scene);
+    if (!(longest > 0.0)) return 1.0;
+    if (params.voxelCount > 0) return longest / params.voxelCount;
+    double h = scene.totalArea > 0.0 && std::isfinite(scene.totalArea)
+                   ? std::sqrt(scene.totalArea / 4096.0)
+                   : longest / 64.0;
+    return std::clamp(h, longest / 1024.0, longest / 4.0);
+}
+
+uint64_t vdbPointCount(const VdbParams& params, const SceneInfo& scene, double h) {
+    if (params.points > 0) return params.points;
+    double n = 16.0 * std::max(scene.totalArea, 0.0) / (h * h);
+    if (!std::isfinite(n)) n = double(uint64_t(1) << 24);
+    return uint64_t(std::clamp(n, 65536.0, double(uint64_t(1) << 24)));
+}
+
+double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
+    const double h = vdbVoxelSize(params, scene);
+    const double points = double(vdbPointCount(params, scene, h));
+    // A flat surface crosses about area / h^2 voxels, an oblique one up to ~3x that.
+    const double crossed = 3.0 * std::max(scene.totalArea, 0.0) / (h * h) + 1024.0;
+    const double voxels = std::min(points, std::isfinite(crossed) ? crossed : points);
+    // Most voxels hold one surface orientation; edges and corners hold more (counted as 2).
+    const double regionsPerVoxel = params.sphere ? 1.0 : 2.0 * std::min(params.normals, 2);
+    const double s = double(params.cols) * params.rows * (params.sphere ? 2.0 : 1.0);
+    const double perRegion = s * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) +
+                             (s + 1) * sizeof(float) + sizeof(HemiFrame);
+    // Per voxel: normals, offsets and about 8 bytes of OpenVDB tree (leaf values and masks).
+    return voxels * (regionsPerVoxel * (perRegion + sizeof(int)) + 2 * sizeof(glm::vec3) + 12.0);
+}
+
+VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
+    : params_(params),
+      layout_(params.cols, params.rows),
+      sceneMin_(scene.boundsMin),
+      sceneMax_(scene.boundsMax),
+      sceneArea_(scene.totalArea),
+      voxelSize_(vdbVoxelSize(params, scene)),
+      invVoxel_(float(1.0 / voxelSize_)),
+      origin_(scene.boundsMin),
+      grid_(std::make_unique<Grid>()),
+      cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * kPi / 180.0))) {
+    openvdb::initialize();
+    const uint64_t wanted = vdbPointCount(params, scene, voxelSize_);
+    openvdb::Int32Grid::Ptr grid = openvdb::Int32Grid::create(-1);
+    grid->setName(kGridName);
+    // Index (i, j, k) covers [origin + (i, j, k) h, origin + (i + 1, j + 1, k + 1) h): OpenVDB
+    // puts voxel centres at index coordinates, so the transform is offset by half a voxel.
+    openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(voxelSize_);
+    xform->postTranslate(openvdb::Vec3d(origin_.x, origin_.y, origin_.z) + 0.5 * voxelSize_);
+    grid->setTransform(xform);
+
+    // Activation: uniform surface samples (Halton sequence through the scene's area sampler).
+    // Per voxel, the samples' normals are clustered greedily: a sample joins the cluster
+    // whose first normal is closest in angle up to normal-angle (either sign), else opens a
+    // new cluster while the voxel has fewer than `normals`, else joins the closest. A
+    // cluster's normal is the sign-aligned mean of its members.
+    struct Cluster {
+        glm::vec3 first;
+        glm::dvec3 sum;
+    };
+    std::vector<std::vector<Cluster>> clusters;
+    const int maxClusters = params_.sphere ? 1 : params_.normals;
+    const float cosAngle = cosMaxAngle_;
+    {
+        openvdb::Int32Grid::Accessor acc = grid->getAccessor();
+        const uint64_t maxAttempts = 2 * wanted + 64;
+        for (uint64_t i = 0; points_ < wanted && i < maxAttempts; ++i) {
+            ++attempts_;
+            glm::vec3 u(radicalInverse(i, 2), radicalInverse(i, 3), radicalInverse(i, 5));
+            glm::vec3 p(0.f), n(0.f);
+            if (!scene.samplePoint || !scene.samplePoint(u, &p, &n)) {
+                if (points_ == 0 && i >= 63) break;  // the scene has no surface
+                continue;
+            }
+            float len = glm::length(n);
+            if (!finite3(p) || !(len > 0.f) || !std::isfinite(len)) continue;
+            n /= len;
+            glm::vec3 c = glm::floor((p - origin_) * invVoxel_);
+            if (!(std::abs(c.x) < kMaxCoord && std::abs(c.y) < kMaxCoord &&
+                  std::abs(c.z) < kMaxCoord))
+                continue;
+            const openvdb::Coord ijk(int(c.x), int(c.y), int(c.z));
+            int v = acc.getValue(ijk);
+            if (v < 0) {
+                v = int(clusters.size());
+                acc.setValue(ijk, v);
+                clusters.emplace_back();
+            }
+            std::vector<Cluster>& cl = clusters[size_t(v)];
+            int best = -1;
+            float bestCos = -1.f;
+            for (size_t k = 0; k < cl.size(); ++k) {
+                float d = std::abs(glm::dot(n, cl[k].first));
+                if (d > bestCos) {
+                    bestCos = d;
+                    best = int(k);
+                }
+            }
+            if (best < 0 || (bestCos < cosAngle && int(cl.size()) < maxClusters)) {
+                cl.push_back(Cluster{n, glm::dvec3(0.0)});
+                best = int(cl.size()) - 1;
+            }
+            Cluster& k = cl[size_t(best)];
+            k.sum += glm::dvec3(glm::dot(n, k.first) >= 0.f ? n : -n);
+            ++points_;
+        }
+    }
+    // Renumber the voxels in the tree's order, so that neighbours' tables are close in memory.
+    clusterStart_.assign(1, 0);
+    clusterNormals_.clear();
+    for (auto it = grid->beginValueOn(); it; ++it) {
+        for (const Cluster& k : clusters[size_t(*it)]) {
+            double l = glm::length(k.sum);
+            clusterNormals_.push_back(l > 1e-12 ? glm::vec3(k.sum / l) : k.first);
+        }
+        it.setValue(int(clusterStart_.size()) - 1);
+        clusterStart_.push_back(uint32_t(clusterNormals_.size()));
+    }
+    grid_->grid = grid;
+    buildFrames();
+    table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
+                 layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
+}
+
+VdbField::~VdbField() = default;
+
+void VdbField::buildFrames() {
+    frames_.clear();
+    regionVoxel_.clear();
+    for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
+        for (uint32_t k = clusterStart_[v]; k < clusterStart_[v + 1]; ++k) {
+            const glm::vec3& n = clusterNormals_[k];
+            frames_.push_back(HemiFrame::fromZ(n));
+            regionVoxel_.push_back(int(v));
+            if (!params_.sphere) {
+                frames_.push_back(HemiFrame::fromZ(-n));
+                regionVoxel_.push_back(int(v));
+            }
+        }
+    const int n = layout_.count();
+    const int s = params_.sphere ? 2 * n : n;
+    centreX_.resize(size_t(s));
+    centreY_.resize(size_t(s));
+    centreZ_.resize(size_t(s));
+    for (int j = 0; j < s; ++j) {
+        glm::vec3 c = j < n ? layout_.centre(j) : -layout_.centre(j - n);
+        centreX_[size_t(j)] = c.x;
+        centreY_[size_t(j)] = c.y;
+        centreZ_[size_t(j)] = c.z;
+    }
+}
+
+void VdbField::buildPolicy(const double* q, float* cdf) const {
+    const int s = table_.strata() > 0 ? table_.strata() : layout_.count() * (params_.sphere ? 2 : 1);
+    if (params_.sphere || !params_.cosine) {
+        buildStrataCdf(q, s, params_.epsilon, cdf);
+        return;
+    }
+    double qc[64 * 64];
+    for (int j = 0; j < s; ++j) qc[j] = q[j] * double(layout_.centre(j).z);
+    buildStrataCdf(qc, s, params_.epsilon, cdf);
+}
+
+StrataTable::PolicyBuilder VdbField::policy() const {
+    return [this](int, const double* q, float* cdf) { buildPolicy(q, cdf); };
+}
+
+glm::ivec3 VdbField::voxelCoord(const glm::vec3& p) const {
+    glm::vec3 c = glm::floor((p - origin_) * invVoxel_);
+    return glm::ivec3(int(std::clamp(c.x, -kMaxCoord, kMaxCoord)),
+                      int(std::clamp(c.y, -kMaxCoord, kMaxCoord)),
+                      int(std::clamp(c.z, -kMaxCoord, kMaxCoord)));
+}
+
+int VdbField::voxelIndex(const glm::ivec3& ijk) const {
+    return grid_->grid->tree().getValue(openvdb::Coord(ijk.x, ijk.y, ijk.z));
+}
+
+int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
+    switch (accessor_) {
+    case Accessor::PerThread: {
+        std::unique_ptr<ConstAccessor>& acc = grid_->accessors.local();
+        if (!acc) acc = std::make_unique<ConstAccessor>(grid_->grid->tree());
+        return lookupWith(p, n, *acc);
+    }
+    case Accessor::Uncached:
+        return lookupWith(p, n, grid_->grid->tree());
+    case Accessor::PerLookup: {
+        ConstAccessor acc(grid_->grid->tree());
+        return lookupWith(p, n, acc);
+    }
+    case Accessor::Hybrid:
+    default: {
+        // Vertices on surfaces almost always hit an active voxel: one uncached probe (no
+        // accessor to set up); the neighbour search, 26 nearby probes, goes through an
+        // accessor made on demand.
+        struct HybridProbe {
+            const openvdb::Int32Tree& tree;
+            std::optional<ConstAccessor> acc;
+            bool first = true;
+            int getValue(const openvdb::Coord& c) {
+                if (first) {
+                    first = false;
+                    return tree.getValue(c);
+                }
+                if (!acc) acc.emplace(tree);
+                return acc->getValue(c);
+            }
+        } probe{grid_->grid->tree(), std::nullopt};
+        return lookupWith(p, n, probe);
+    }
+    }
+}
+
+template <class Probe>
+int VdbField::lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) const {
+    if (clusterNormals_.empty() || !finite3(p)) return -1;
+    if (!params_.sphere && !(glm::dot(n, n) > 0.f)) return -1;
+    const glm::vec3 c = glm::floor((p - origin_) * invVoxel_);
+    if (!(std::abs(c.x) < kMaxCoord && std::abs(c.y) < kMaxCoord && std::abs(c.z) < kMaxCoord))
+        return -1;
+    const openvdb::Coord ijk(int(c.x), int(c.y), int(c.z));
+    int v = probe.getValue(ijk);
+    if (v < 0) {
+        // The nearest active voxel among the 26 neighbours (distance from p to the voxel's
+        // box; ties go to the first in z, y, x order), else no data.
+        const glm::vec3 f = (p - origin_) * invVoxel_ - c;  // position inside the voxel, [0,1]
+        float best = FLT_MAX;
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    if (!(dx | dy | dz)) continue;
+                    int vi = probe.getValue(ijk.offsetBy(dx, dy, dz));
+                    if (vi < 0) continue;
+                    auto axis = [](int d, float t) {
+                        return d < 0 ? t : (d > 0 ? 1.f - t : 0.f);
+                    };
+                    const float ax = axis(dx, f.x), ay = axis(dy, f.y), az = axis(dz, f.z);
+                    const float d2 = ax * ax + ay * ay + az * az;
+                    if (d2 < best) {
+                        best = d2;
+                        v = vi;
+                    }
+                }
+        if (v < 0) return -1;
+    }
+    if (params_.sphere) return v;
+    // The voxel's dominant normal closest to n (either side), if within normal-angle.
+    const float threshold = cosMaxAngle_ * glm::length(n);
+    int best = -1;
+    float bestCos = -1.f;
+    bool flip = false;
+    for (uint32_t k = clusterStart_[size_t(v)], e = clusterStart_[size_t(v) + 1]; k < e; ++k) {
+        const float d = glm::dot(n, clusterNormals_[k]);
+        if (std::abs(d) > bestCos) {
+            bestCos = std::abs(d);
+            best = int(k);
+            flip = d < 0.f;
+        }
+    }
+    if (best < 0 || !(bestCos >= threshold)) return -1;
+    return 2 * best + (flip ? 1 : 0);
+}
+
+int VdbField::stratumOf(int region, const glm::vec3& w) const {
+    if (!validRegion(region)) return -1;
+    float len = glm::length(w);
+    if (!(len > 0.f) || !std::isfinite(len)) return -1;
+    const glm::vec3 local = frames_[size_t(region)].toLocal(w / len);
+    if (!params_.sphere) return layout_.stratumOf(local);
+    if (local.z > 0.f) return layout_.stratumOf(local);
+    if (!(local.z < 0.f)) return -1;  // the equator (measure zero) or NaN
+    int j = layout_.stratumOf(-local);
+    return j < 0 ? -1 : layout_.count() + j;
+}
+
+glm::vec3 VdbField::strataCentre(int region, int j) const {
+    const size_t k = size_t(j);
+    return frames_[size_t(region)].toWorld(glm::vec3(centreX_[k], centreY_[k], centreZ_[k]));
+}
+
+float VdbField::pdf(int region, const glm::vec3& w) const {
+    int j = stratumOf(region, w);
+    if (j < 0) return 0.f;
+    return strataProbability(table_.cdf(size_t(region)), j) *
+           static_cast<float>(layout_.count() / (2.0 * kPi));
+}
+
+glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut) const {
+    if (!validRegion(region)) {
+        *pdfOut = 0.f;
+        return glm::vec3(0.f);
+    }
+    const float* c = table_.cdf(size_t(region));
+    const int n = layout_.count();
+    const int j = sampleStrataCdf(c, table_.strata(), uStratum);
+    glm::vec3 local = j < n ? layout_.sampleStratum(j, u) : -layout_.sampleStratum(j - n, u);
+    glm::vec3 w = glm::normalize(frames_[size_t(region)].toWorld(local));
+    // Report exactly pdf(region, w) (rounding may move w across a stratum edge); on the
+    // hemisphere's rim (pdf 0) keep the drawn stratum's density, as hemi does.
+    float p = pdf(region, w);
+    if (!(p > 0.f)) p = strataProbability(c, j) * static_cast<float>(n / (2.0 * kPi));
+    *pdfOut = p;
+    return w;
+}
+
+float VdbField::scatteredEstimate(int region,
+                                  const std::function<float(const glm::vec3&)>& fcos) const {
+    if (!validRegion(region)) return 0.f;
+    const double* q = table_.q(size_t(region));
+    double acc = 0.0;
+    for (int j = 0; j < table_.strata(); ++j) {
+        float f = fcos(strataCentre(region, j));
+        if (f > 0.f && std::isfinite(f)) acc += q[j] * double(f);
+    }
+    return static_cast<float>(std::min(acc * layout_.stratumSolidAngle(), double(FLT_MAX)));
+}
+
+float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
+    if (!validRegion(region) || !finite3(n)) return 0.f;
+    const glm::vec3 nl = frames_[size_t(region)].toLocal(n);
+    const float* q = table_.qf(size_t(region));
+    const float *cx = centreX_.data(), *cy = centreY_.data(), *cz = centreZ_.data();
+    float acc = 0.f;
+    for (int j = 0, s = table_.strata(); j < s; ++j) {
+        float c = cx[j] * nl.x + cy[j] * nl.y + cz[j] * nl.z;
+        acc += q[j] * std::max(c, 0.f);
+    }
+    return static_cast<float>(
+        std::min(double(acc) * layout_.stratumSolidAngle(), double(FLT_MAX)));
+}
+
+float VdbField::radiance(int region, const glm::vec3& w) const {
+    int j = stratumOf(region, w);
+    if (j < 0) return 0.f;
+    return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
+}
+
+void VdbField::beginPass(int numSlots) { table_.beginPass(numSlots); }
+
+void VdbField::record(int slot, int region, const glm::vec3& w, float target) {
+    table_.record(slot, region, target, [&] { return stratumOf(region, w); });
+}
+
+void VdbField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy()); }
+
+size_t VdbField::gridBytes() const { return size_t(grid_->grid->memUsage()); }
+
+size_t VdbField::bytes() const {
+    return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
+           clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
+           frames_.capacity() * sizeof(HemiFrame) +
+           3 * centreX_.capacity() * sizeof(float);
+}
+
+std::string VdbField::describe() const {
+    char alpha[32];
+    if (params_.alphaVisits)
+        std::snprintf(alpha, sizeof(alpha), "visits");
+    else
+        std::snprintf(alpha, sizeof(alpha), "%g", params_.fixedAlpha);
+    const GuidingStats& s = table_.stats();
+    char buf[640];
+    std::snprintf(buf, sizeof(buf),
+                  "vdb: %zu active voxels of %g (from %llu points, %llu draws), %zu normals, "
+                  "%d regions (%s), %dx%d strata, alpha=%s, init=%g, epsilon=%g, cosine=%d, %.1f MiB "
+                  "(grid %.2f MiB; +%.1f MiB record buffers); passes=%llu, records=%llu, "
+                  "rejected targets=%llu, rejected records=%llu",
+                  activeVoxels(), voxelSize_, (unsigned long long)points_,
+                  (unsigned long long)attempts_, clusterCount(), numRegions(),
+                  params_.sphere ? "full sphere per voxel" : "two hemispheres per normal",
+                  params_.cols, params_.rows, alpha, params_.init, params_.epsilon,
+                  int(params_.cosine && !params_.sphere), double(bytes()) / (1024.0 * 1024.0),
+                  double(gridBytes()) / (1024.0 * 1024.0),
+                  double(scratchBytes()) / (1024.0 * 1024.0), (unsigned long long)s.passes,
+                  (unsigned long long)s.records, (unsigned long long)s.rejectedTargets,
+                  (unsigned long long)s.rejectedRecords);
+    return buf;
+}
+
+GuidingStats VdbField::stats() const {
+    GuidingStats s = table_.stats();
+    s.activeVoxels = activeVoxels();
+    return s;
+}
+
+// ---- Save / load: an OpenVDB file with one Int32Grid and the tables as grid metadata ----
+
+bool VdbField::save(const std::string& path, std::string* error) const {
+    try {
+        openvdb::GridBase::Ptr copy = grid_->grid->copyGrid();  // shares the tree
+        copy->insertMeta("rlpbrt:format", openvdb::StringMetadata("rlpbrt guiding field"));
+        copy->insertMeta("rlpbrt:version", openvdb::Int32Metadata(kFileVersion));
+        copy->insertMeta("rlpbrt:backend", openvdb::StringMetadata("vdb"));
+        copy->insertMeta("rlpbrt:dirs", openvdb::StringMetadata(params_.sphere ? "sphere" : "hemi"));
+        copy->insertMeta("rlpbrt:bounds_min",
+                         openvdb::Vec3SMetadata(openvdb::Vec3s(sceneMin_.x, sceneMin_.y, sceneMin_.z)));
+        copy->insertMeta("rlpbrt:bounds_max",
+                         openvdb::Vec3SMetadata(openvdb::Vec3s(sceneMax_.x, sceneMax_.y, sceneMax_.z)));
+        copy->insertMeta("rlpbrt:area", openvdb::DoubleMetadata(sceneArea_));
+        copy->insertMeta("rlpbrt:voxel_size", openvdb::DoubleMetadata(voxelSize_));
+        copy->insertMeta("rlpbrt:points", openvdb::Int64Metadata(int64_t(points_)));
+        copy->insertMeta("rlpbrt:strata", openvdb::Vec2IMetadata(openvdb::Vec2i(params_.cols, params_.rows)));
+        copy->insertMeta("rlpbrt:normals_max", openvdb::Int32Metadata(params_.normals));
+        copy->insertMeta("rlpbrt:normal_angle", openvdb::DoubleMetadata(params_.normalAngleDeg));
+        fieldio::Writer counts, normals;
+        for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
+            counts.u32(clusterStart_[v + 1] - clusterStart_[v]);
+        for (const glm::vec3& n : clusterNormals_) normals.vec3(n);
+        copy->insertMeta("rlpbrt:clusters", openvdb::StringMetadata(counts.data));
+        copy->insertMeta("rlpbrt:normals", openvdb::StringMetadata(normals.data));
+        copy->insertMeta("rlpbrt:q", openvdb::StringMetadata(fieldio::packDoubles(table_.qTable())));
+        copy->insertMeta("rlpbrt:visits",
+                         openvdb::StringMetadata(fieldio::packU64(table_.visitTable())));
+        const GuidingStats& s = table_.stats();
+        copy->insertMeta("rlpbrt:passes", openvdb::Int64Metadata(int64_t(s.passes)));
+        copy->insertMeta("rlpbrt:records", openvdb::Int64Metadata(int64_t(s.records)));
+        copy->insertMeta("rlpbrt:rejected_targets", openvdb::Int64Metadata(int64_t(s.rejectedTargets)));
+        copy->insertMeta("rlpbrt:rejected_records", openvdb::Int64Metadata(int64_t(s.rejectedRecords)));
+        const std::string tmp = path + ".tmp";
+        {
+            openvdb::io::File file(tmp);
+            file.write(openvdb::GridCPtrVec{copy});
+            file.close();
+        }
+        if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+            std::remove(tmp.c_str());
+            *error = "cannot rename '" + tmp + "' to '" + path + "'";
+            return false;
+        }
+    } catch (const std::exception& e) {
+        *error = "cannot write '" + path + "': " + e.what();
+        return false;
+    }
+    return true;
+}
+
+bool VdbField::load(const std::string& path, std::string* error) {
+    const std::string kind = fieldio::fileKind(path);
+    if (kind.empty()) {
+        *error = "'" + path + "' is not a saved guiding field (or cannot be read)";
+        return false;
+    }
+    if (kind != "vdb") {
+        *error = "'" + path + "' holds a '" + kind +
+                 "' guiding field; the vdb backend loads only fields it saved";
+        return false;
+    }
+    openvdb::Int32Grid::Ptr grid;
+    try {
+        openvdb::io::File file(path);
+        file.open();
+        if (!file.hasGrid(kGridName)) {
+            *error = "'" + path + "' is an OpenVDB file without an rlpbrt guiding grid";
+            return false;
+        }
+        grid = openvdb::gridPtrCast<openvdb::Int32Grid>(file.readGrid(kGridName));
+        file.close();
+    } catch (const std::exception& e) {
+        *error = "cannot read '" + path + "': " + e.what();
+        return false;
+    }
+    if (!grid) {
+        *error = "'" + path + "': the guiding grid is not an Int32Grid";
+        return false;
+    }
+    auto fail = [&](const std::string& why) {
+        *error = "'" + path + "': " + why;
+        return false;
+    };
+    try {
+        if (grid->metaValue<std::string>("rlpbrt:backend") != "vdb")
+            return fail("not a vdb guiding field");
+        if (grid->metaValue<int32_t>("rlpbrt:version") != kFileVersion)
+            return fail("unsupported version " +
+                        std::to_string(grid->metaValue<int32_t>("rlpbrt:version")));
+        openvdb::Vec3s bmin = grid->metaValue<openvdb::Vec3s>("rlpbrt:bounds_min");
+        openvdb::Vec3s bmax = grid->metaValue<openvdb::Vec3s>("rlpbrt:bounds_max");
+        std::string why;
+        if (!fieldio::sameScene(glm::vec3(bmin.x(), bmin.y(), bmin.z()),
+                                glm::vec3(bmax.x(), bmax.y(), bmax.z()),
+                                grid->metaValue<double>("rlpbrt:area"), sceneMin_, sceneMax_,
+                                sceneArea_, &why))
+            return fail(why);
+        const double h = grid->metaValue<double>("rlpbrt:voxel_size");
+        const int64_t pts = grid->metaValue<int64_t>("rlpbrt:points");
+        if (h != voxelSize_ || uint64_t(pts) != points_) {
+            char buf[256];
+            std::snprintf(buf, sizeof(buf),
+                          "voxel size %.9g with %lld points, this field has %.9g with %llu "
+                          "(use the same voxel/voxel-size/points parameters)",
+                          h, (long long)pts, voxelSize_, (unsigned long long)points_);
+            return fail(buf);
+        }
+        const openvdb::Vec2i st = grid->metaValue<openvdb::Vec2i>("rlpbrt:strata");
+        const std::string dirs = grid->metaValue<std::string>("rlpbrt:dirs");
+        if (st.x() != params_.cols || st.y() != params_.rows ||
+            dirs != (params_.sphere ? "sphere" : "hemi"))
+            return fail("strata " + std::to_string(st.x()) + "x" + std::to_string(st.y()) +
+                        " dirs=" + dirs + ", this field has " + std::to_string(params_.cols) +
+                        "x" + std::to_string(params_.rows) +
+                        " dirs=" + (params_.sphere ? "sphere" : "hemi"));
+        const int normalsMax = grid->metaValue<int32_t>("rlpbrt:normals_max");
+        const double normalAngle = grid->metaValue<double>("rlpbrt:normal_angle");
+        if (!params_.sphere &&
+            (normalsMax != params_.normals || normalAngle != params_.normalAngleDeg))
+            return fail("normals=" + std::to_string(normalsMax) + " normal-angle=" +
+                        std::to_string(normalAngle) + ", this field has normals=" +
+                        std::to_string(params_.normals) +
+                        " normal-angle=" + std::to_string(params_.normalAngleDeg));
+        const size_t voxels = size_t(grid->activeVoxelCount());
+        std::vector<char> seen(voxels, 0);
+        for (auto it = grid->cbeginValueOn(); it; ++it) {
+            const int v = *it;
+            if (v < 0 || size_t(v) >= voxels || seen[size_t(v)]) return fail("corrupt voxel indices");
+            seen[size_t(v)] = 1;
+        }
+        const std::string cblob = grid->metaValue<std::string>("rlpbrt:clusters");
+        if (cblob.size() != voxels * 4) return fail("corrupt cluster table");
+        std::vector<uint32_t> starts(1, 0);
+        fieldio::Reader cr(cblob);
+        for (size_t v = 0; v < voxels; ++v) {
+            const uint32_t c = cr.u32();
+            if (c < 1 || c > uint32_t(params_.sphere ? 1 : params_.normals))
+                return fail("corrupt cluster table");
+            starts.push_back(starts.back() + c);
+        }
+        const size_t count = starts.back();
+        const std::string nblob = grid->metaValue<std::string>("rlpbrt:normals");
+        if (nblob.size() != count * 12) return fail("corrupt normals table");
+        std::vector<glm::vec3> normals(count);
+        fieldio::Reader nr(nblob);
+        for (glm::vec3& n : normals) {
+            n = nr.vec3();
+            if (!finite3(n) || std::abs(glm::length(n) - 1.f) > 1e-3f)
+                return fail("corrupt normals table");
+        }
+        const size_t regions = count * (params_.sphere ? 1 : 2);
+        const size_t strata = size_t(layout_.count()) * (params_.sphere ? 2 : 1);
+        std::vector<double> q;
+        std::vector<uint64_t> visits;
+        if (!fieldio::unpackDoubles(grid->metaValue<std::string>("rlpbrt:q"), regions * strata, &q) ||
+            !fieldio::unpackU64(grid->metaValue<std::string>("rlpbrt:visits"), regions * strata,
+                                &visits))
+            return fail("corrupt Q or visit table");
+        for (double d : q)
+            if (!(d >= 0.0) || !std::isfinite(d)) return fail("corrupt Q table");
+        GuidingStats s;
+        s.passes = uint64_t(grid->metaValue<int64_t>("rlpbrt:passes"));
+        s.records = uint64_t(grid->metaValue<int64_t>("rlpbrt:records"));
+        s.rejectedTargets = uint64_t(grid->metaValue<int64_t>("rlpbrt:rejected_targets"));
+        s.rejectedRecords = uint64_t(grid->metaValue<int64_t>("rlpbrt:rejected_records"));
+        // Commit.
+        grid->clearMetadata();
+        grid->setName(kGridName);
+        grid_->grid = grid;
+        grid_->accessors.clear();
+        clusterStart_ = std::move(starts);
+        clusterNormals_ = std::move(normals);
+        buildFrames();
+        table_.reset(regions, int(strata), params_.init, policy());
+        table_.assign(std::move(q), std::move(visits), policy());
+        table_.stats() = s;
+    } catch (const std::exception& e) {
+        return fail(std::string("missing or bad metadata: ") + e.what());
+    }
+    return true;
+}
+
+}  // namespace rlpbrt::guiding

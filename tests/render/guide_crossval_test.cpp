@@ -1,0 +1,97 @@
+// Cross-validation of the guiding backends: on the same scene and seed, the images of
+// --guide=none, hemi and vdb must have the same expectation (guiding changes the noise only).
+// For each pair the difference image D = A - B has expectation 0 at every pixel. It is cut
+// into 20x20-pixel blocks whose means m_b are independent, zero-mean estimates (the pixel
+// filter correlates only pixels near block edges); the standard error of mean(D) is then
+// sqrt(sum m_b^2) / B, and |mean(D)| must stay within 4 of them (per channel).
+#include <cmath>
+#include <cstdio>
+
+#include "guiding/guiding.h"
+#include "parser/diagnostics.h"
+#include "render/render.h"
+#include "render/scene.h"
+#include "render/scene_builder.h"
+#include "shared_data.h"
+
+namespace rlpbrt {
+namespace {
+
+struct Rendered {
+    Image image;
+    guiding::GuidingStats stats;
+};
+
+Rendered renderWith(const std::string& scenePath, const char* backend, int spp) {
+    Diagnostics diag;
+    diag.setStream(nullptr);
+    SceneDesc desc;
+    EXPECT_TRUE(loadSceneDesc(scenePath, diag, &desc));
+    BuildOptions bo;
+    bo.sppOverride = spp;
+    bo.seed = 7;
+    std::unique_ptr<Scene> scene = buildScene(desc, bo, diag);
+    EXPECT_NE(scene, nullptr);
+    if (!scene) return {};
+    guiding::GuideConfig gc;
+    gc.backend = backend;
+    std::unique_ptr<guiding::GuidingField> field;
+    RenderOptions ro;
+    std::string err;
+    EXPECT_TRUE(setupGuiding(*scene, gc, &field, &ro.guide, &err)) << err;
+    ro.nThreads = 1;  // CTest runs tests in parallel
+    Rendered out;
+    out.image = render(*scene, ro).image;
+    if (field) out.stats = field->stats();
+    return out;
+}
+
+// |mean(A - B)| in units of its standard error from 20x20 block means, per channel.
+void expectSameMean(const Image& a, const Image& b, const char* what) {
+    ASSERT_EQ(a.width, b.width);
+    ASSERT_EQ(a.height, b.height);
+    constexpr int kBlock = 20;
+    const int bx = a.width / kBlock, by = a.height / kBlock;
+    ASSERT_GE(bx * by, 50);
+    for (int c = 0; c < 3; ++c) {
+        double sum = 0.0, sumSq = 0.0, meanA = 0.0;
+        for (int j = 0; j < by; ++j)
+            for (int i = 0; i < bx; ++i) {
+                double m = 0.0;
+                for (int y = j * kBlock; y < (j + 1) * kBlock; ++y)
+                    for (int x = i * kBlock; x < (i + 1) * kBlock; ++x) {
+                        m += double(a.at(x, y, c)) - double(b.at(x, y, c));
+                        meanA += a.at(x, y, c);
+                    }
+                m /= kBlock * kBlock;
+                sum += m;
+                sumSq += m * m;
+            }
+        const double blocks = double(bx * by);
+        const double mean = sum / blocks, se = std::sqrt(sumSq) / blocks;
+        meanA /= blocks * kBlock * kBlock;
+        std::printf("%s channel %d: mean %.6g, difference %.3g +- %.3g (%.2f sigma)\n", what, c,
+                    meanA, mean, se, se > 0 ? std::abs(mean) / se : 0.0);
+        EXPECT_GT(se, 0.0) << what << ": identical images (the guide was not used?)";
+        EXPECT_LE(std::abs(mean), 4.0 * se) << what << " channel " << c;
+    }
+}
+
+TEST(GuideCrossValidation, NoneHemiVdbAgreeOnCornellBox) {
+    RLPBRT_REQUIRE_SHARED();
+    const std::string scene = test::sharedDir() + "/scenes/cornell-box/scene.small.pbrt";
+    const int spp = 16;
+    Rendered none = renderWith(scene, "none", spp);
+    Rendered hemi = renderWith(scene, "hemi", spp);
+    Rendered vdb = renderWith(scene, "vdb", spp);
+    ASSERT_FALSE(none.image.empty());
+    EXPECT_GT(hemi.stats.records, 0u);
+    EXPECT_GT(vdb.stats.records, 0u);
+    EXPECT_GT(vdb.stats.activeVoxels, 0u);
+    expectSameMean(hemi.image, none.image, "hemi - none");
+    expectSameMean(vdb.image, none.image, "vdb - none");
+    expectSameMean(hemi.image, vdb.image, "hemi - vdb");
+}
+
+}  // namespace
+}  // namespace rlpbrt

@@ -1,0 +1,111 @@
+// --guide-save / --guide-load through the command line: a saved field loads into a new run of
+// the same scene and backend; another scene, another backend or a bad file is an error with a
+// clear message and exit status 1; --stats reports the vdb grid's active voxels.
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+struct CliRun {
+    int status = -1;
+    std::string output;
+};
+
+CliRun run(const std::string& args) {
+    CliRun r;
+    std::string cmd = std::string(RLPBRT_BINARY) + " " + args + " 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return r;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.output.append(buf, n);
+    int st = pclose(p);
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return r;
+}
+
+// A 24x24 box room lit by a quad; `wide` moves a wall so the bounds change.
+std::string writeScene(const std::string& path, bool wide) {
+    std::ofstream f(path);
+    f << "LookAt 0 0.5 3  0 0.5 0  0 1 0\nCamera \"perspective\" \"float fov\" 50\n"
+         "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+         "Sampler \"random\" \"integer pixelsamples\" 2\nWorldBegin\n"
+         "AttributeBegin\n  AreaLightSource \"diffuse\" \"rgb L\" [8 8 8]\n"
+         "  Shape \"trianglemesh\" \"point P\" [-0.2 0.99 -0.2  0.2 0.99 -0.2  0.2 0.99 0.2  "
+         "-0.2 0.99 0.2] \"integer indices\" [0 1 2 0 2 3]\nAttributeEnd\n"
+         "Material \"matte\"\n";
+    const float x = wide ? 1.5f : 1.f;
+    f << "Shape \"trianglemesh\" \"point P\" [-1 0 -1  " << x << " 0 -1  " << x << " 0 1  -1 0 1  -1 1 -1  "
+      << x << " 1 -1  " << x << " 1 1  -1 1 1] \"integer indices\" [0 1 2 0 2 3  4 6 5 4 7 6  "
+         "0 4 5 0 5 1  0 3 7 0 7 4]\nWorldEnd\n";
+    return path;
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream f(path);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+TEST(GuideFileCli, SaveLoadAndMismatchErrors) {
+    char tmpl[] = "/tmp/rlpbrt-guidefile-XXXXXX";
+    const std::string dir = mkdtemp(tmpl) ? tmpl : "/tmp";
+    const std::string a = writeScene(dir + "/a.pbrt", false);
+    const std::string b = writeScene(dir + "/b.pbrt", true);
+    const std::string out = " -o " + dir + "/out.exr --nthreads 1 ";
+    const std::string vdbFile = dir + "/field.vdb", hemiFile = dir + "/field.hemi";
+
+    CliRun save = run(a + out + "--guide=vdb --guide-save " + vdbFile + " --stats " + dir +
+                   "/s.json --quiet");
+    ASSERT_EQ(save.status, 0) << save.output;
+    struct stat st;
+    ASSERT_EQ(stat(vdbFile.c_str(), &st), 0);
+    EXPECT_GT(st.st_size, 1000);
+    const std::string json = slurp(dir + "/s.json");
+    EXPECT_NE(json.find("\"guide_active_voxels\""), std::string::npos) << json;
+
+    CliRun load = run(a + out + "--guide=vdb --guide-load " + vdbFile + " --quiet");
+    EXPECT_EQ(load.status, 0) << load.output;
+
+    CliRun otherScene = run(b + out + "--guide=vdb --guide-load " + vdbFile + " --quiet");
+    EXPECT_EQ(otherScene.status, 1) << otherScene.output;
+    EXPECT_NE(otherScene.output.find("another scene"), std::string::npos) << otherScene.output;
+
+    CliRun otherVoxel =
+        run(a + out + "--guide=vdb --guide-param voxel=3 --guide-load " + vdbFile + " --quiet");
+    EXPECT_EQ(otherVoxel.status, 1) << otherVoxel.output;
+    EXPECT_NE(otherVoxel.output.find("voxel size"), std::string::npos) << otherVoxel.output;
+
+    CliRun otherBackend = run(a + out + "--guide=hemi --guide-load " + vdbFile + " --quiet");
+    EXPECT_EQ(otherBackend.status, 1) << otherBackend.output;
+    EXPECT_NE(otherBackend.output.find("'vdb' guiding field"), std::string::npos)
+        << otherBackend.output;
+
+    CliRun hemiSave = run(a + out + "--guide=hemi --guide-save " + hemiFile + " --quiet");
+    ASSERT_EQ(hemiSave.status, 0) << hemiSave.output;
+    CliRun hemiLoad = run(a + out + "--guide=hemi --guide-load " + hemiFile + " --quiet");
+    EXPECT_EQ(hemiLoad.status, 0) << hemiLoad.output;
+    CliRun hemiIntoVdb = run(a + out + "--guide=vdb --guide-load " + hemiFile + " --quiet");
+    EXPECT_EQ(hemiIntoVdb.status, 1) << hemiIntoVdb.output;
+    EXPECT_NE(hemiIntoVdb.output.find("'hemi' guiding field"), std::string::npos)
+        << hemiIntoVdb.output;
+
+    CliRun missing = run(a + out + "--guide=vdb --guide-load " + dir + "/nope.vdb --quiet");
+    EXPECT_EQ(missing.status, 1) << missing.output;
+    CliRun noBackend = run(a + out + "--guide-load " + vdbFile + " --quiet");
+    EXPECT_EQ(noBackend.status, 1) << noBackend.output;
+
+    for (const char* f : {"a.pbrt", "b.pbrt", "out.exr", "s.json", "field.vdb", "field.hemi"})
+        std::remove((dir + "/" + f).c_str());
+    rmdir(dir.c_str());
+}
+
+}  // namespace
