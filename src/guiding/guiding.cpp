@@ -181,10 +181,15 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             if (!parseUnsigned(value, 16, &u) || u < 1)
                 return badValue("vdb", key, value, "an integer in 1..16", error);
             vp->normals = int(u);
+        } else if (key == "warmup") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
+                return badValue("vdb", key, value, "a number in [0, 1e9]", error);
+            vp->warmup = d;
         } else {
             *error = "guiding backend 'vdb': unknown parameter '" + key +
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
-                     "normal-angle, init, epsilon, cosine, max-mb, mix, target)";
+                     "normal-angle, init, epsilon, cosine, warmup, max-mb, mix, target)";
             return false;
         }
     }

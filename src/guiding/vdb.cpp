@@ -171,6 +171,7 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     buildFrames();
     table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
                  layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
+    resetConfidence();
 }
 
 VdbField::~VdbField() = default;
@@ -213,7 +214,23 @@ void VdbField::buildPolicy(const double* q, float* cdf) const {
 }
 
 StrataTable::PolicyBuilder VdbField::policy() const {
-    return [this](int, const double* q, float* cdf) { buildPolicy(q, cdf); };
+    return [this](int region, const double* q, float* cdf) {
+        buildPolicy(q, cdf);
+        if (region < 0 || size_t(region) >= confidence_.size()) return;
+        const uint64_t* v = table_.visits(size_t(region));
+        double visits = 0.0;
+        for (int j = 0; j < table_.strata(); ++j) visits += double(v[j]);
+        const double w = params_.warmup * double(table_.strata());
+        confidence_[size_t(region)] = w > 0.0 ? float(visits / (visits + w)) : 1.f;
+    };
+}
+
+void VdbField::resetConfidence() {
+    confidence_.assign(table_.regions(), params_.warmup > 0.0 ? 0.f : 1.f);
+}
+
+float VdbField::confidence(int region) const {
+    return region >= 0 && size_t(region) < confidence_.size() ? confidence_[size_t(region)] : 0.f;
 }
 
 glm::ivec3 VdbField::voxelCoord(const glm::vec3& p) const {
@@ -400,7 +417,7 @@ size_t VdbField::gridBytes() const { return size_t(grid_->grid->memUsage()); }
 size_t VdbField::bytes() const {
     return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
            clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
-           frames_.capacity() * sizeof(HemiFrame) +
+           frames_.capacity() * sizeof(HemiFrame) + confidence_.capacity() * sizeof(float) +
            3 * centreX_.capacity() * sizeof(float);
 }
 
@@ -610,6 +627,7 @@ bool VdbField::load(const std::string& path, std::string* error) {
         clusterNormals_ = std::move(normals);
         buildFrames();
         table_.reset(regions, int(strata), params_.init, policy());
+        resetConfidence();
         table_.assign(std::move(q), std::move(visits), policy());
         table_.stats() = s;
     } catch (const std::exception& e) {

@@ -31,6 +31,7 @@ struct VdbParams {
     bool sphere = false;      // one full-sphere table per voxel instead of hemispheres
     int normals = 4;          // at most this many dominant normals (hemisphere pairs) a voxel
     double normalAngleDeg = 30;  // normal clustering angle and lookup's admissible deviation
+    double warmup = 16.0;     // confidence = visits / (visits + warmup * strata), as hemi
 };
 
 // The voxel edge and surface-sample count the parameters give for a scene.
@@ -54,6 +55,7 @@ public:
                             const std::function<float(const glm::vec3&)>& fcos) const override;
     float irradianceEstimate(int region, const glm::vec3& n) const override;
     float radiance(int region, const glm::vec3& w) const override;
+    float confidence(int region) const override;
     void beginPass(int numSlots) override;
     void record(int slot, int region, const glm::vec3& w, float target) override;
     void endPass() override;
@@ -130,6 +132,10 @@ private:
     std::vector<glm::vec3> clusterNormals_;  // unit dominant normal per cluster
     std::vector<int> regionVoxel_;          // per region
     std::vector<HemiFrame> frames_;         // per region
+    // Per region: visits / (visits + warmup * strata), refreshed with each CDF build (the
+    // policy builder is const, called concurrently for distinct regions).
+    mutable std::vector<float> confidence_;
+    void resetConfidence();
     std::vector<float> centreX_, centreY_, centreZ_;  // local stratum centres (all strata)
     StrataTable table_;
     Accessor accessor_ = Accessor::Hybrid;
