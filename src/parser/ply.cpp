@@ -454,6 +454,7 @@ bool readVertices(BodyReader& r, const Element& e, PlyMesh* mesh) {
     bool hasN = seen[int(Role::NX)] && seen[int(Role::NY)] && seen[int(Role::NZ)];
     bool hasUV = seen[int(Role::U)] && seen[int(Role::V)];
     size_t n = size_t(e.count);
+    if (n == 0) return true;  // (faces then fail: no index can be in range)
     mesh->positions.resize(3 * n);
     if (hasN) mesh->normals.resize(3 * n);
     if (hasUV) mesh->uvs.resize(2 * n);
