@@ -31,8 +31,8 @@ cmake --build "$build" --parallel 2 --target "${targets[@]}"
 status=0
 for t in "${targets[@]}"; do
   case $t in
-    fuzz_parser) seeds=("$here/fuzz/corpus/parser" "$here/tests/data/bad"); dict=$here/fuzz/pbrt.dict ;;
-    fuzz_ply) seeds=("$here/fuzz/corpus/ply" "$here/tests/data/ply" "$here/tests/data/bad/ply"); dict=$here/fuzz/ply.dict ;;
+    fuzz_parser) seeds=("$here/fuzz/corpus/parser" "$here/fuzz/regressions/parser" "$here/tests/data/bad"); dict=$here/fuzz/pbrt.dict ;;
+    fuzz_ply) seeds=("$here/fuzz/corpus/ply" "$here/fuzz/regressions/ply" "$here/tests/data/ply" "$here/tests/data/bad/ply"); dict=$here/fuzz/ply.dict ;;
     fuzz_spd) seeds=("$here/fuzz/corpus/spd"); dict= ;;
     *) echo "fuzz: unknown target $t" >&2; exit 2 ;;
   esac
