@@ -176,6 +176,8 @@ TEST_P(BadInputCli, LocatedErrorNonZeroExitNoOutput) {
     for (const auto& [loc, msg] : errors)
         found = found || (loc == e.loc && msg.find(e.text) != std::string::npos);
     EXPECT_TRUE(found) << "expected " << e.loc << ": error: ..." << e.text << "\nin:\n" << r.err;
+    // No follow-up error without a location.
+    EXPECT_EQ(r.err.find("<unknown>: error:"), std::string::npos) << r.err;
     EXPECT_TRUE(tmp.entries().empty()) << "left behind: " << tmp.entries().front();
 }
 
