@@ -8,7 +8,8 @@ build=${1:-$here/build}
 pkgs=(build-essential cmake ninja-build pkg-config
       libembree-dev libopenimageio-dev libopenexr-dev libimath-dev libopenvdb-dev libglm-dev libtbb-dev
       libboost-iostreams-dev openimageio-tools libopencv-core-dev
-      libcli11-dev libfmt-dev nlohmann-json3-dev libnanoflann-dev libgtest-dev libgmock-dev libbenchmark-dev)
+      libcli11-dev libfmt-dev nlohmann-json3-dev libnanoflann-dev libgtest-dev libgmock-dev libbenchmark-dev
+      clang llvm libclang-rt-14-dev)  # clang + libFuzzer runtime: scripts/fuzz.sh
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -72,18 +72,14 @@ std::size_t Param::size() const {
 }
 
 void ParamList::add(Param p) {
-    for (auto& q : params_)
-        if (q.name == p.name) {
-            q = std::move(p);
-            return;
-        }
-    params_.push_back(std::move(p));
+    auto [it, inserted] = index_.emplace(p.name, params_.size());
+    if (inserted) params_.push_back(std::move(p));
+    else params_[it->second] = std::move(p);
 }
 
 const Param* ParamList::find(const std::string& name) const {
-    for (const auto& p : params_)
-        if (p.name == name) return &p;
-    return nullptr;
+    auto it = index_.find(name);
+    return it == index_.end() ? nullptr : &params_[it->second];
 }
 
 void ParamList::typeError(const Param& p, const char* expected) const {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "parser/diagnostics.h"
@@ -104,6 +105,9 @@ private:
     void typeError(const Param& p, const char* expected) const;
 
     std::vector<Param> params_;
+    // Name -> position in params_: keeps add() and find() constant-time, so that a directive
+    // with very many parameters is not quadratic.
+    std::unordered_map<std::string, std::size_t> index_;
     Diagnostics* diag_ = nullptr;
 };
 

@@ -409,6 +409,10 @@ private:
     void include(const Token& dir) {
         std::string name;
         if (!readString(&name, dir, "a file name")) return;
+        if (name.empty()) {
+            diag_.error(dir.loc, "empty file name in " + std::string(dir.text));
+            return;
+        }
         std::string path = (name.empty() || name[0] == '/') ? name : dir.loc.directory() + name;
         if (int(stack_.size()) >= limits_.maxIncludeDepth) {
             diag_.error(dir.loc, "Include nested more than " +

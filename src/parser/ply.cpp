@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <sys/stat.h>
 
 namespace rlpbrt {
 namespace {
@@ -454,6 +455,7 @@ bool readVertices(BodyReader& r, const Element& e, PlyMesh* mesh) {
     bool hasN = seen[int(Role::NX)] && seen[int(Role::NY)] && seen[int(Role::NZ)];
     bool hasUV = seen[int(Role::U)] && seen[int(Role::V)];
     size_t n = size_t(e.count);
+    if (n == 0) return true;  // (faces then fail: no index can be in range)
     mesh->positions.resize(3 * n);
     if (hasN) mesh->normals.resize(3 * n);
     if (hasUV) mesh->uvs.resize(2 * n);
@@ -707,6 +709,12 @@ bool readPlyFromMemory(const char* data, size_t size, PlyMesh* mesh, std::string
 bool readPly(const std::string& path, PlyMesh* mesh, std::string* error) {
     std::string dummy;
     if (!error) error = &dummy;
+    // Only regular files: a FIFO would block and a device would never end.
+    struct stat st;
+    if (stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+        *error = "cannot read '" + path + "': not a regular file";
+        return false;
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         *error = "cannot open '" + path + "': " + std::strerror(errno);

@@ -1,13 +1,17 @@
 #include "parser/spd.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
 
 namespace rlpbrt {
 
 namespace {
+
+constexpr long long kMaxSpdBytes = 64ll << 20;
 
 bool fail(std::string* error, const std::string& message) {
     if (error) *error = message;
@@ -17,6 +21,13 @@ bool fail(std::string* error, const std::string& message) {
 }  // namespace
 
 bool readSpdFile(const std::string& path, std::vector<double>* pairs, std::string* error) {
+    // Only regular files of sane size: a device such as /dev/zero would be read forever.
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0) return fail(error, path + ": cannot open spectral data file");
+    if (!S_ISREG(st.st_mode)) return fail(error, path + ": not a regular file");
+    if (st.st_size > kMaxSpdBytes)
+        return fail(error, path + ": spectral data file larger than " +
+                               std::to_string(kMaxSpdBytes >> 20) + " MiB");
     std::ifstream in(path);
     if (!in) return fail(error, path + ": cannot open spectral data file");
 
@@ -34,7 +45,7 @@ bool readSpdFile(const std::string& path, std::vector<double>* pairs, std::strin
             char* end = nullptr;
             errno = 0;
             double v = std::strtod(begin, &end);
-            if (end == begin || *end != '\0' || errno == ERANGE) {
+            if (end == begin || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
                 return fail(error, path + ":" + std::to_string(lineNo) +
                                        ": expected a number, found \"" + word + "\"");
             }

@@ -61,6 +61,12 @@ std::unique_ptr<Tokenizer> Tokenizer::fromFile(const std::string& path, Diagnost
             }
         }
     }
+    // Not mapped: read it, unless it claims more than any scene file should (e.g. /proc/kcore).
+    if (st.st_size > (off_t(1) << 32)) {
+        diag.error(includedFrom, "cannot read file \"" + path + "\" (" +
+                                     std::to_string((long long)st.st_size) + " bytes)");
+        return nullptr;
+    }
     FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) {
         diag.error(includedFrom, "cannot open file \"" + path + "\"");

@@ -20,6 +20,10 @@ FilmParams parseFilm(const ParamList& params, std::string* error) {
     fp.yResolution = params.getInt("yresolution", fp.yResolution);
     if (fp.xResolution <= 0 || fp.yResolution <= 0)
         err = "film \"xresolution\" and \"yresolution\" must be positive";
+    else if (int64_t(fp.xResolution) * fp.yResolution > MaxFilmPixels)
+        err = "film resolution " + std::to_string(fp.xResolution) + "x" +
+              std::to_string(fp.yResolution) + " is too large (at most " +
+              std::to_string(MaxFilmPixels) + " pixels)";
     if (params.has("cropwindow")) {
         std::vector<float> cw = params.getFloats("cropwindow");
         if (cw.size() == 4) {

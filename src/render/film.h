@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -50,6 +51,10 @@ struct Bounds2i {
 inline Bounds2i intersect(const Bounds2i& a, const Bounds2i& b) {
     return Bounds2i(glm::max(a.pMin, b.pMin), glm::min(a.pMax, b.pMax));
 }
+
+// Largest film accepted (xresolution * yresolution): 8192 x 8192, about 2 GiB of pixel sums.
+// Bounds memory and keeps pixel counts within int.
+constexpr int64_t MaxFilmPixels = int64_t(1) << 26;
 
 // Parameters of Film "image" with pbrt-v3's defaults.
 struct FilmParams {

@@ -180,7 +180,7 @@ bool readExr(const std::string& path, Image* out, std::string* error, ImageFileI
         Imf::InputFile in(path.c_str());
         const Imath::Box2i dw = in.header().dataWindow();
         const long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
-        if (w <= 0 || h <= 0 || double(w) * double(h) > 1e9)
+        if (w <= 0 || h <= 0 || double(w) * double(h) > double(MaxImagePixels))
             return fail(error, "image \"" + path + "\" has an unsupported size");
         const Imf::ChannelList& ch = in.header().channels();
         bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
@@ -288,6 +288,25 @@ bool readImage(const std::string& path, Image* out, std::string* error, ImageFil
         }
     }
     *out = std::move(img);
+    return true;
+}
+
+bool checkOutputPath(const std::string& path, std::string* error) {
+    const std::string ext = lowerExtension(path);
+    if (ext != ".exr" && ext != ".png" && ext != ".pfm" && ext != ".hdr")
+        return fail(error, "cannot write \"" + path +
+                               "\": unknown image format (use .exr, .png, .pfm or .hdr)");
+    std::string dir = std::filesystem::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    struct stat st;
+    if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+        return fail(error, "cannot write \"" + path + "\": directory \"" + dir +
+                               "\" does not exist");
+    if (access(dir.c_str(), W_OK) != 0)
+        return fail(error, "cannot write \"" + path + "\": directory \"" + dir +
+                               "\" is not writable");
+    if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+        return fail(error, "cannot write \"" + path + "\": it is a directory");
     return true;
 }
 

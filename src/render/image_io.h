@@ -38,6 +38,10 @@ struct ImageFileInfo {
     bool eightBit = false; // true when the file stores 8-bit unsigned integer channels
 };
 
+// Largest image readImage() accepts (width * height; 1.5 GiB as float RGB): bounds the
+// memory an absurd header can claim. The OpenImageIO module applies the same limit.
+constexpr long long MaxImagePixels = 1ll << 27;
+
 // Reads the first subimage of an image file into *out as float RGB (channels = 3, top row
 // first). One- and two-channel (grey, grey+alpha) files are expanded to RGB; channels after
 // the third are dropped (alpha is dropped, never multiplied in). Integer formats are mapped
@@ -72,6 +76,11 @@ bool writeImage(const std::string& path, const Image& img,
 // nothing is left behind on failure.
 bool writeFileAtomically(const std::string& path, const std::string& content,
                          std::string* error);
+
+// Checks, before a render, that writeImage(path, ...) can succeed as far as can be known
+// without writing: a known extension and an existing, writable directory. False with a
+// message in *error otherwise (so that no render is wasted on an unwritable output).
+bool checkOutputPath(const std::string& path, std::string* error);
 
 // sRGB decoding (IEC 61966-2-1), as pbrt-v3's InverseGammaCorrect: v <= 0.04045 ? v / 12.92
 // : ((v + 0.055) / 1.055)^2.4. Encoded value in, linear value out.

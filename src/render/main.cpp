@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "parser/diagnostics.h"
+#include "render/checkpoint.h"
 #include "render/image_io.h"
 #include "render/metrics.h"
 #include "render/render.h"
@@ -66,7 +67,7 @@ int main(int argc, char** argv) {
     std::string guideSave, guideLoad;
     bool parseOnly = false, quiet = false;
     int spp = 0, nThreads = 0;
-    double timeBudget = 0.0;
+    double timeBudget = 0.0, checkpointEvery = -1.0;
     uint64_t seed = 0;
     app.add_option("scene", scenePath, "pbrt-v3 scene file")->required();
     app.add_flag("--parse-only", parseOnly, "parse and build the scene, print a summary, exit");
@@ -95,6 +96,10 @@ int main(int argc, char** argv) {
     app.add_option("--curve", curveFile, "write seconds,spp,relmse against --ref after each "
                                          "pass to this CSV file")
         ->needs(refOpt);
+    app.add_option("--checkpoint", checkpointEvery,
+                   "write the image so far (atomically, real spp in its metadata) after each "
+                   "pass once SECONDS have passed since the last checkpoint")
+        ->check(CLI::Range(0.0, 1e9));
     CLI11_PARSE(app, argc, argv);
     // From here on SIGINT/SIGTERM finish the current pass and write the image so far.
     std::signal(SIGINT, onSignal);
@@ -168,6 +173,13 @@ int main(int argc, char** argv) {
     const float mix = guideSettings.mix;
 
     if (outFile.empty()) outFile = defaultOutput(*scene);
+    {
+        std::string err;  // no render for an output that cannot be written
+        if (!checkOutputPath(outFile, &err)) {
+            std::fprintf(stderr, "%s: error: %s\n", outFile.c_str(), err.c_str());
+            return 1;
+        }
+    }
     RenderOptions ro;
     // Error curve: relMSE against the reference after each pass, computed while its cost
     // stays under 1% of the render time so far (passes are skipped otherwise), with that
@@ -206,16 +218,24 @@ int main(int argc, char** argv) {
     ro.progress = !quiet && isatty(STDERR_FILENO);
     ro.cancel = &gCancel;
     ro.guide = guideSettings;
+    auto metadata = [&](int spp, double renderSeconds) -> ImageMetadata {
+        return {
+            {"rlpbrt:version", RLPBRT_VERSION},
+            {"rlpbrt:spp", std::to_string(spp)},
+            {"rlpbrt:seconds", std::to_string(renderSeconds)},
+            {"rlpbrt:seed", std::to_string(seed)},
+            {"rlpbrt:guide", guide},
+            {"rlpbrt:scene", scenePath},
+        };
+    };
+    Checkpointer checkpoint(outFile, checkpointEvery, metadata);
+    if (checkpointEvery >= 0.0)
+        ro.onPass = chainOnPass(std::move(ro.onPass), [&](int spp, double t, const Film& film) {
+            checkpoint.onPass(spp, t, film);
+        });
     RenderResult r = render(*scene, ro);
 
-    std::vector<std::pair<std::string, std::string>> meta = {
-        {"rlpbrt:version", RLPBRT_VERSION},
-        {"rlpbrt:spp", std::to_string(r.spp)},
-        {"rlpbrt:seconds", std::to_string(r.seconds)},
-        {"rlpbrt:seed", std::to_string(seed)},
-        {"rlpbrt:guide", guide},
-        {"rlpbrt:scene", scenePath},
-    };
+    ImageMetadata meta = metadata(r.spp, r.seconds);
     std::string err;
     if (!writeImage(outFile, r.image, meta, &err)) {
         std::fprintf(stderr, "%s: error: %s\n", outFile.c_str(), err.c_str());
@@ -267,6 +287,7 @@ int main(int argc, char** argv) {
         }
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;
+        j["checkpoints"] = checkpoint.written();
         std::ofstream f(statsFile);
         f << j.dump(2) << "\n";
         if (!f) {

@@ -463,7 +463,10 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         if (type != "image" && desc.film.present)
             diag.warning(desc.film.loc, "film \"" + type + "\" is treated as \"image\"");
         s.filmParams = parseFilm(desc.film.params, &err);
-        if (!err.empty()) diag.error(desc.film.loc, err);
+        if (!err.empty()) {
+            diag.error(desc.film.loc, err);
+            s.filmParams = FilmParams();  // defaults: no follow-up errors from the camera
+        }
         desc.film.params.reportUnused("Film \"" + type + "\"");
     }
     {

@@ -166,6 +166,15 @@ bool makeLoopSubdiv(const ShapeEntity& e, Diagnostics& diag, TriangleMesh* m) {
         diag.error(e.loc, ctx(e) + ": needs \"integer indices\" and \"point3 P\"");
         return false;
     }
+    // Each level splits every triangle in four: bound the result before allocating it.
+    const double outTriangles = double(idx.size() / 3) * std::pow(4.0, levels);
+    if (outTriangles > double(1 << 26)) {
+        diag.error(e.loc, ctx(e) + ": " + std::to_string(idx.size() / 3) + " triangles at nlevels " +
+                              std::to_string(levels) + " would make " +
+                              std::to_string((long long)outTriangles) +
+                              " triangles (at most 67108864)");
+        return false;
+    }
     std::vector<Vec3> outP, outN;
     std::vector<int> outIdx;
     std::string err;

@@ -212,7 +212,9 @@ TEST_P(GridTracking, TrackersMatchAnalyticTransmittance) {
     }
     EXPECT_NEAR(ratio.mean(), expected, 4.5 * ratio.stderror() + 1e-6) << "ratio tracking";
     EXPECT_NEAR(delta.mean(), expected, 4.5 * delta.stderror() + 1e-6) << "delta tracking";
-    if (scatterWeight.n) EXPECT_NEAR(scatterWeight.mean(), 0.75, 1e-6);  // sigma_s / sigma_t
+    if (scatterWeight.n) {
+        EXPECT_NEAR(scatterWeight.mean(), 0.75, 1e-6);  // sigma_s / sigma_t
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Segments, GridTracking,

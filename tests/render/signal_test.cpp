@@ -1,5 +1,5 @@
 // No lost work: SIGINT or SIGTERM during a render writes the image so far (its real spp in
-// the statistics and metadata) and exits with 130.
+// the statistics and the EXR metadata) and exits with 130.
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "render/exr_header.h"
 #include "render/image_io.h"
 
 namespace {
@@ -55,6 +56,10 @@ void interruptedRender(int sig) {
     int spp = std::stoi(json.substr(pos + 7));
     EXPECT_GE(spp, 1);
     EXPECT_LT(spp, 1000000);
+    // The image's metadata carries the same real spp.
+    auto attrs = rlpbrt::test::exrStringAttributes(out);
+    ASSERT_EQ(attrs.count("rlpbrt:spp"), 1u);
+    EXPECT_EQ(attrs["rlpbrt:spp"], std::to_string(spp));
     std::remove(out.c_str());
     std::remove(stats.c_str());
     rmdir(dir.c_str());

@@ -2,6 +2,7 @@
 // OpenImageIO pulls in about 260 shared libraries whose loading costs ~0.4 s at every start,
 // which commands that never touch an image (--parse-only, --help, bad-input errors) should not
 // pay. A plain C interface keeps the boundary simple.
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -32,7 +33,7 @@ int rlpbrt_oiio_read(const char* path, float** data, int* w, int* h, int* nc, in
     }
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1 ||
-        double(spec.width) * spec.height * spec.nchannels > 1e10) {
+        double(spec.width) * spec.height > double(int64_t(1) << 27) || spec.nchannels > 64) {
         setError(err, errLen, "image \"" + std::string(path) + "\" has an unsupported size or layout");
         return 0;
     }
