@@ -7,13 +7,6 @@ namespace rlpbrt::guiding {
 
 namespace {
 constexpr uint32_t kLeaf = 3;
-// Deep enough for 2^64 points: the search stack holds at most one entry per level.
-constexpr int kMaxDepth = 64;
-
-struct StackItem {
-    uint32_t node;
-    float dist2;  // squared distance from the query to the node's splitting plane
-};
 }  // namespace
 
 PointKdTree::PointKdTree(const std::vector<glm::vec3>& points) {
@@ -59,13 +52,10 @@ void PointKdTree::build(const std::vector<glm::vec3>& points, size_t node, size_
     build(points, 2 * node + 2, mid, end, level + 1);
 }
 
-int PointKdTree::nearest(const glm::vec3& q, float* dist2) const {
-    float best = FLT_MAX;
-    int bestIndex = -1;
-    if (ids_.empty()) {
-        *dist2 = best;
-        return -1;
-    }
+template <class VisitPoint, class Bound>
+void PointKdTree::search(const glm::vec3& q, VisitPoint&& visit, Bound&& bound) const {
+    // Depth first, nearer child first; a subtree is skipped when its splitting plane is no
+    // closer than bound() (the current pruning distance).
     StackItem stack[kMaxDepth];
     int sp = 0;
     uint32_t node = 0;
@@ -74,29 +64,40 @@ int PointKdTree::nearest(const glm::vec3& q, float* dist2) const {
         if (nd.axis == kLeaf) {
             for (uint32_t i = nd.begin; i < nd.end; ++i) {
                 const glm::vec3 d = points_[i] - q;
-                const float dd = glm::dot(d, d);
-                if (dd < best) {
-                    best = dd;
-                    bestIndex = static_cast<int>(i);
-                }
+                visit(i, glm::dot(d, d));
             }
-            // Next subtree whose splitting plane is closer than the best point so far.
             bool found = false;
             while (sp > 0) {
                 const StackItem& it = stack[--sp];
-                if (it.dist2 < best) {
+                if (it.dist2 < bound()) {
                     node = it.node;
                     found = true;
                     break;
                 }
             }
-            if (!found) break;
+            if (!found) return;
             continue;
         }
         const float diff = q[int(nd.axis)] - nd.split;
         const uint32_t left = 2 * node + 1;
         stack[sp++] = StackItem{diff < 0.f ? left + 1 : left, diff * diff};
         node = diff < 0.f ? left : left + 1;
+    }
+}
+
+int PointKdTree::nearest(const glm::vec3& q, float* dist2) const {
+    float best = FLT_MAX;
+    int bestIndex = -1;
+    if (!ids_.empty()) {
+        search(
+            q,
+            [&](uint32_t i, float dd) {
+                if (dd < best) {
+                    best = dd;
+                    bestIndex = static_cast<int>(i);
+                }
+            },
+            [&] { return best; });
     }
     *dist2 = best;
     return bestIndex < 0 ? -1 : static_cast<int>(ids_[size_t(bestIndex)]);
@@ -109,43 +110,21 @@ int PointKdTree::knn(const glm::vec3& q, int k, uint32_t* indices, float* dist2)
     uint32_t cand[kMaxK];
     float candD[kMaxK];
     int count = 0;
-    StackItem stack[kMaxDepth];
-    int sp = 0;
-    uint32_t node = 0;
     auto worst = [&] { return count < k ? FLT_MAX : candD[k - 1]; };
-    for (;;) {
-        const Node& nd = nodes_[node];
-        if (nd.axis == kLeaf) {
-            for (uint32_t i = nd.begin; i < nd.end; ++i) {
-                const glm::vec3 d = points_[i] - q;
-                const float dd = glm::dot(d, d);
-                if (!(dd < worst())) continue;
-                int pos = count < k ? count++ : k - 1;
-                while (pos > 0 && candD[pos - 1] > dd) {
-                    candD[pos] = candD[pos - 1];
-                    cand[pos] = cand[pos - 1];
-                    --pos;
-                }
-                candD[pos] = dd;
-                cand[pos] = i;
+    search(
+        q,
+        [&](uint32_t i, float dd) {
+            if (!(dd < worst())) return;
+            int pos = count < k ? count++ : k - 1;
+            while (pos > 0 && candD[pos - 1] > dd) {
+                candD[pos] = candD[pos - 1];
+                cand[pos] = cand[pos - 1];
+                --pos;
             }
-            bool found = false;
-            while (sp > 0) {
-                const StackItem& it = stack[--sp];
-                if (it.dist2 < worst()) {
-                    node = it.node;
-                    found = true;
-                    break;
-                }
-            }
-            if (!found) break;
-            continue;
-        }
-        const float diff = q[int(nd.axis)] - nd.split;
-        const uint32_t left = 2 * node + 1;
-        stack[sp++] = StackItem{diff < 0.f ? left + 1 : left, diff * diff};
-        node = diff < 0.f ? left : left + 1;
-    }
+            candD[pos] = dd;
+            cand[pos] = i;
+        },
+        worst);
     for (int i = 0; i < count; ++i) {
         indices[i] = ids_[cand[i]];
         dist2[i] = candD[i];

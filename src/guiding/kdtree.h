@@ -42,6 +42,15 @@ private:
     };
     void build(const std::vector<glm::vec3>& points, size_t node, size_t begin, size_t end,
                int level);
+    // Deep enough for 2^64 points: the search stack holds at most one entry per level.
+    static constexpr int kMaxDepth = 64;
+    struct StackItem {
+        uint32_t node;
+        float dist2;  // squared distance from the query to the node's splitting plane
+    };
+    // Visits points (leaf index, squared distance) of the subtrees bound() does not prune.
+    template <class VisitPoint, class Bound>
+    void search(const glm::vec3& q, VisitPoint&& visit, Bound&& bound) const;
 
     int depth_ = 0;                    // leaves are at this level (root = 0)
     std::vector<Node> nodes_;          // children of node i: 2i + 1 and 2i + 2
