@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Summarises a bench/curves.sh run: a markdown table and (with matplotlib) plots.
 
     bench/curves_report.py OUTDIR [--plots]
@@ -102,7 +102,10 @@ def main():
         print("| | equal time: {:.1f} s | | | | | | | | |".format(t_end))
     if not plots:
         return
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        sys.exit("plots need Debian's python3-matplotlib (run with /usr/bin/python3)")
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     scenes = list(runs)
