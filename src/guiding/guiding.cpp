@@ -4,6 +4,8 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <new>
+#include <stdexcept>
 #include <cstdlib>
 
 #include "guiding/hemi.h"
@@ -227,7 +229,12 @@ std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
             *error = buf;
             return nullptr;
         }
-        return std::make_unique<HemiField>(hp, scene);
+        try {
+            return std::make_unique<HemiField>(hp, scene);
+        } catch (const std::bad_alloc&) {
+            *error = "guiding backend 'hemi': out of memory for the tables";
+            return nullptr;
+        }
     }
     if (config.backend == "vdb") {
         VdbParams vp;
@@ -247,7 +254,13 @@ std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
             *error = buf;
             return nullptr;
         }
-        return std::make_unique<VdbField>(vp, scene);
+        // OpenVDB reports trouble (e.g. an allocation) by exceptions: a message, not a crash.
+        try {
+            return std::make_unique<VdbField>(vp, scene);
+        } catch (const std::exception& e) {
+            *error = std::string("guiding backend 'vdb': ") + e.what();
+            return nullptr;
+        }
     }
     *error = "unknown guiding backend '" + config.backend + "' (available: none, hemi, vdb)";
     return nullptr;

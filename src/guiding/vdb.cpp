@@ -96,9 +96,16 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     grid->setName(kGridName);
     // Index (i, j, k) covers [origin + (i, j, k) h, origin + (i + 1, j + 1, k + 1) h): OpenVDB
     // puts voxel centres at index coordinates, so the transform is offset by half a voxel.
-    openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(voxelSize_);
-    xform->postTranslate(openvdb::Vec3d(origin_.x, origin_.y, origin_.z) + 0.5 * voxelSize_);
-    grid->setTransform(xform);
+    // The transform only informs other tools reading a saved .vdb (lookups use origin_ and
+    // invVoxel_, and loading reads the voxel size from metadata). OpenVDB refuses scales it
+    // considers zero (edges below about 1e-6, a scene at scale 1e-4): keep the identity there.
+    try {
+        openvdb::math::Transform::Ptr xform =
+            openvdb::math::Transform::createLinearTransform(voxelSize_);
+        xform->postTranslate(openvdb::Vec3d(origin_.x, origin_.y, origin_.z) + 0.5 * voxelSize_);
+        grid->setTransform(xform);
+    } catch (const openvdb::Exception&) {
+    }
 
     // Activation: uniform surface samples (Halton sequence through the scene's area sampler).
     // Per voxel, the samples' normals are clustered greedily: a sample joins the cluster

@@ -162,7 +162,17 @@ std::string plane(double rho, double L) {
            "WorldEnd\n";
 }
 
-const char* kBackends[] = {"none", "hemi"};
+// The plane seen at grazing incidence: camera 1 above it looking 20 ahead (2-4 degrees below
+// the horizon), every pixel on the plane. Same exact answer rho * L.
+std::string grazingPlane(double rho, double L) {
+    std::string s = plane(rho, L);
+    const std::string look = "LookAt 0 0 1  0 0 0  0 1 0", fov = "\"float fov\" 30";
+    s.replace(s.find(look), look.size(), "LookAt 0 0 1  0 20 0  0 0 1");
+    s.replace(s.find(fov), fov.size(), "\"float fov\" 2");
+    return s;
+}
+
+const char* kBackends[] = {"none", "hemi", "vdb"};
 
 class Analytic : public ::testing::TestWithParam<const char*> {};
 
@@ -181,6 +191,7 @@ TEST_P(Analytic, ClosedEnclosureGeometricSeries) {
 
 TEST_P(Analytic, PlaneUnderConstantSky) {
     expectMean(renderText(plane(0.7, 2.0), GetParam()), 1.4, "plane");
+    expectMean(renderText(grazingPlane(0.7, 2.0), GetParam()), 1.4, "plane at grazing view");
 }
 
 // Lossless delta BSDFs inside the uniform field of a closed enclosure: a mirror of
@@ -305,6 +316,7 @@ const Extreme kExtremes[] = {
     {"strata_64x64", {{"strata", "64x64"}, {"points", "256"}}},
     {"points_1", {{"points", "1"}}},
     {"points_200000", {{"points", "200000"}, {"strata", "2x2"}}},
+    {"points_1000000", {{"points", "1000000"}, {"strata", "1x1"}}},
     {"mix_1_pure_policy", {{"mix", "1"}, {"warmup", "0"}}},
     {"mix_0", {{"mix", "0"}}},
     {"epsilon_0", {{"epsilon", "0"}, {"mix", "1"}, {"warmup", "0"}}},
