@@ -70,7 +70,15 @@ std::string quote(const std::string& s) { return "'" + s + "'"; }
 CliRun runRlpbrt(const std::string& args, const std::string& dir) {
     CliRun r;
     std::string errFile = dir + "/../" + fs::path(dir).filename().string() + ".stderr";
-    std::string cmd = "cd " + quote(dir) + " && ulimit -v " + std::to_string(kMemoryLimitKb) +
+#if defined(__SANITIZE_ADDRESS__)
+    // AddressSanitizer reserves terabytes of address space for its shadow memory, so a
+    // virtual-memory limit cannot apply; its own resident-memory limit bounds the run instead.
+    const std::string memLimit = "export ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:hard_rss_limit_mb=" +
+                                 std::to_string(kMemoryLimitKb / 1024) + "\"";
+#else
+    const std::string memLimit = "ulimit -v " + std::to_string(kMemoryLimitKb);
+#endif
+    std::string cmd = "cd " + quote(dir) + " && " + memLimit +
                       " && timeout -k 5 " + std::to_string(kTimeLimitSec) + " " +
                       quote(RLPBRT_BINARY) + " " + args + " >/dev/null 2>" + quote(errFile);
     auto t0 = std::chrono::steady_clock::now();
