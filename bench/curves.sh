@@ -6,7 +6,7 @@
 # configurations of one scene run at the same time, one thread each, so that they share
 # whatever else the machine is doing; compare them with each other, not across scenes run
 # at different times. Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
-# commas for spaces), default none, hemi, hemi with mix 0.25/0.75, vdb if built in.
+# commas for spaces), default none, hemi, vdb and one variation of each main parameter.
 # Writes OUTDIR/<scene>__<config>.{csv,json,exr}; bench/curves_report.py summarises them.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -17,8 +17,13 @@ out=${2:?usage: $0 SECONDS OUTDIR [scene-id ...]}
 shift 2
 mkdir -p "$out"
 want=" $* "
-default="none=--guide,none hemi=--guide,hemi hemi-mix0.25=--guide,hemi,--guide-param,mix=0.25 hemi-mix0.75=--guide,hemi,--guide-param,mix=0.75"
-if "$bin" --help 2>/dev/null | grep -q vdb; then default="$default vdb=--guide,vdb"; fi
+# The backends and their main parameters: strata, points / voxel size, mix.
+default="none=--guide,none hemi=--guide,hemi vdb=--guide,vdb"
+default="$default hemi-strata4x4=--guide,hemi,--guide-param,strata=4x4"
+default="$default hemi-points32768=--guide,hemi,--guide-param,points=32768"
+default="$default vdb-voxel32=--guide,vdb,--guide-param,voxel=32"
+default="$default hemi-mix0.25=--guide,hemi,--guide-param,mix=0.25"
+default="$default hemi-mix0.75=--guide,hemi,--guide-param,mix=0.75"
 configs=${CONFIGS:-$default}
 {
     echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"

@@ -12,5 +12,6 @@ cmake --build "$build" --parallel "$(nproc)" --target rlpbrt rlpbrt_oiio rlpbrt-
     rlpbrt_tests rlpbrt_image_tests
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export LSAN_OPTIONS=suppressions=$here/tests/lsan.supp
 cd "$build"
 ctest -L fast --output-on-failure --timeout 600 -j "$(nproc)"

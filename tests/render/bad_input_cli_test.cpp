@@ -73,8 +73,12 @@ CliRun runRlpbrt(const std::string& args, const std::string& dir) {
 #if defined(__SANITIZE_ADDRESS__)
     // AddressSanitizer reserves terabytes of address space for its shadow memory, so a
     // virtual-memory limit cannot apply; its own resident-memory limit bounds the run instead.
+    // Full malloc stacks so that tests/lsan.supp can name OpenImageIO's leaks on the error
+    // paths these bad images take.
     const std::string memLimit = "export ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:hard_rss_limit_mb=" +
-                                 std::to_string(kMemoryLimitKb / 1024) + "\"";
+                                 std::to_string(kMemoryLimitKb / 1024) +
+                                 ":fast_unwind_on_malloc=0\" LSAN_OPTIONS=\"suppressions=" +
+                                 std::string(RLPBRT_SOURCE_DIR) + "/tests/lsan.supp\"";
 #else
     const std::string memLimit = "ulimit -v " + std::to_string(kMemoryLimitKb);
 #endif
