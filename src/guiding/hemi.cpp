@@ -181,18 +181,15 @@ void HemiField::record(int slot, int region, const glm::vec3& w, float target) {
 
 void HemiField::updateRegion(int region) {
     const double* q = table_.q(size_t(region));
-    const uint64_t* visitCounts = table_.visits(size_t(region));
-    double m[3] = {0.0, 0.0, 0.0}, visits = 0.0;
+    double m[3] = {0.0, 0.0, 0.0};
     for (int j = 0; j < strata_; ++j) {
         const glm::vec3& c = layout_.centre(j);
         m[0] += q[j] * double(c.x);
         m[1] += q[j] * double(c.y);
         m[2] += q[j] * double(c.z);
-        visits += double(visitCounts[j]);
     }
     RegionFrame& rf = frames_[size_t(region)];
-    const double w = params_.warmup * double(strata_);
-    rf.confidence = w > 0.0 ? float(visits / (visits + w)) : 1.f;
+    rf.confidence = table_.confidence(size_t(region), params_.warmup);
     const double sa = layout_.stratumSolidAngle();
     const HemiFrame& f = rf.frame;
     glm::vec3 world;

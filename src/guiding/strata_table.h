@@ -31,6 +31,17 @@ public:
     const uint64_t* visits(size_t region) const { return &visits_[region * size_t(strata_)]; }
     const float* cdf(size_t region) const { return &cdf_[region * size_t(strata_ + 1)]; }
 
+    // Confidence of a region's policy: visits / (visits + warmup * strata) over all its
+    // strata (1 for warmup 0), the factor both backends apply to the guide's mixture weight.
+    float confidence(size_t region, double warmup) const {
+        const double w = warmup * double(strata_);
+        if (!(w > 0.0)) return 1.f;
+        const uint64_t* v = visits(region);
+        double total = 0.0;
+        for (int j = 0; j < strata_; ++j) total += double(v[j]);
+        return float(total / (total + w));
+    }
+
     // Per-pass record buffers (see GuidingField::beginPass/record).
     void beginPass(int numSlots);
     bool slotOpen(int slot) const { return slot >= 0 && size_t(slot) < slots_.size(); }

@@ -224,11 +224,7 @@ StrataTable::PolicyBuilder VdbField::policy() const {
     return [this](int region, const double* q, float* cdf) {
         buildPolicy(q, cdf);
         if (region < 0 || size_t(region) >= confidence_.size()) return;
-        const uint64_t* v = table_.visits(size_t(region));
-        double visits = 0.0;
-        for (int j = 0; j < table_.strata(); ++j) visits += double(v[j]);
-        const double w = params_.warmup * double(table_.strata());
-        confidence_[size_t(region)] = w > 0.0 ? float(visits / (visits + w)) : 1.f;
+        confidence_[size_t(region)] = table_.confidence(size_t(region), params_.warmup);
     };
 }
 

@@ -9,20 +9,14 @@
 #include <vector>
 
 #include "render/chi2.h"
+#include "test_scenes.h"
 
 namespace rlpbrt::guiding {
 namespace {
 
-// Uniform direction on the sphere by normalising a Gaussian vector: independent of the
+// Uniform directions on the sphere (normalised Gaussian vectors): independent of the
 // cylindrical map under test.
-glm::vec3 gaussianDirection(std::mt19937_64& rng) {
-    std::normal_distribution<float> g;
-    glm::vec3 v;
-    do {
-        v = glm::vec3(g(rng), g(rng), g(rng));
-    } while (glm::length(v) < 1e-6f);
-    return glm::normalize(v);
-}
+using test::gaussianDirection;
 
 TEST(StrataLayout, SampleLandsInItsStratumAndCentresInside) {
     std::mt19937_64 rng(7);
