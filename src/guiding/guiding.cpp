@@ -17,6 +17,10 @@ GuidingField::~GuidingField() = default;
 
 float GuidingField::confidence(int region) const { return region >= 0 ? 1.f : 0.f; }
 
+int GuidingField::lookupMedium(const glm::vec3&) const { return -1; }
+
+void GuidingField::requestMedium(int, const glm::vec3&) {}
+
 float GuidingField::irradianceEstimate(int region, const glm::vec3& n) const {
     return scatteredEstimate(region,
                              [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
@@ -188,10 +192,20 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
                 return badValue("vdb", key, value, "a number in [0, 1e9]", error);
             vp->warmup = d;
+        } else if (key == "volume") {
+            if (value != "0" && value != "1") return badValue("vdb", key, value, "0 or 1", error);
+            vp->volume = value == "1";
+        } else if (key == "volume-voxel") {
+            if (!parseUnsigned(value, 1024, &u) || u < 1)
+                return badValue("vdb", key, value,
+                                "a voxel count along the longest axis of the media, 1..1024",
+                                error);
+            vp->volumeVoxels = int(u);
         } else {
             *error = "guiding backend 'vdb': unknown parameter '" + key +
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
-                     "normal-angle, init, epsilon, cosine, warmup, max-mb, mix, target)";
+                     "normal-angle, init, epsilon, cosine, warmup, volume, volume-voxel, "
+                     "max-mb, mix, target)";
             return false;
         }
     }
@@ -254,6 +268,11 @@ std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
             *error = buf;
             return nullptr;
         }
+        // The volume tables grow during rendering: they get the rest of the budget.
+        const double perVoxel = 2.0 * vp.cols * vp.rows *
+                                    (sizeof(double) + 2 * sizeof(float) + sizeof(uint64_t)) +
+                                64.0;
+        vp.volumeMaxVoxels = uint64_t(std::max(0.0, (maxMiB - mib) * 1024.0 * 1024.0 / perVoxel));
         // OpenVDB reports trouble (e.g. an allocation) by exceptions: a message, not a crash.
         try {
             return std::make_unique<VdbField>(vp, scene);

@@ -29,10 +29,18 @@ struct SceneInfo {
     glm::vec3 boundsMin{0.f}, boundsMax{0.f};
     double totalArea = 0.0;  // total surface area in scene units squared
     std::function<bool(const glm::vec3& u, glm::vec3* p, glm::vec3* n)> samplePoint;
+    // A box bounding where the scene's participating media can scatter light (empty,
+    // mediaMin > mediaMax, for a scene without media): backends that guide at medium
+    // vertices place their volume cells in it.
+    glm::vec3 mediaMin{1.f}, mediaMax{0.f};
+    bool hasMedia() const {
+        return mediaMin.x <= mediaMax.x && mediaMin.y <= mediaMax.y && mediaMin.z <= mediaMax.z;
+    }
 };
 
 // Counters of the learning process, cumulative over all passes.
 struct GuidingStats {
+    uint64_t mediumCells = 0;       // volume cells (medium vertices' tables) in use
     uint64_t passes = 0;            // completed endPass() calls
     uint64_t records = 0;           // targets applied to the field
     uint64_t rejectedTargets = 0;   // NaN, Inf or negative targets dropped by record()
@@ -51,6 +59,14 @@ public:
     // Region for a vertex at p whose hemisphere of interest is around unit normal n (the
     // integrator passes the shading normal flipped to wo's side). -1 = no data: use the BSDF.
     virtual int lookup(const glm::vec3& p, const glm::vec3& n) const = 0;
+    // Region for a scattering vertex at p inside a participating medium, whose directions
+    // cover the whole sphere; -1 = no data there (sample the phase function). All the
+    // per-region calls below accept it. Default: -1 (the backend guides on surfaces only).
+    virtual int lookupMedium(const glm::vec3& p) const;
+    // Asks the field to model the medium around p (a medium vertex where lookupMedium found
+    // no data) from the next pass on. Thread-safe across slots, like record(). Default:
+    // ignored.
+    virtual void requestMedium(int slot, const glm::vec3& p);
     // Samples a unit world direction from the frozen policy of `region` (u places it inside
     // the stratum chosen by uStratum; all in [0,1)); *pdf is per steradian and equals
     // pdf(region, result) (> 0 for a valid region; 0 and a zero vector for an invalid one).
@@ -136,6 +152,11 @@ public:
 //                worth of surface area, at least 65536, at most 2^24)
 //   dirs         "hemi" (default): two hemispheres per voxel, around its mean normal and its
 //                opposite; "sphere": one full-sphere table per voxel
+//   volume       1 (default) or 0: guide at medium vertices (scenes with media only) with
+//                full-sphere tables (2 x strata) on a second grid over the media bounds,
+//                whose voxels are activated where paths scatter (guiding/vdb_volume.h)
+//   volume-voxel N: N voxels along the longest axis of the media bounds, 1..1024
+//                (default 32); max-mb caps the number of activated voxels
 std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
                                                  const SceneInfo& scene, std::string* error);
 

@@ -27,6 +27,17 @@ void StrataTable::reset(size_t regions, int strata, double init, const PolicyBui
     stats_ = GuidingStats();
 }
 
+void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy) {
+    if (regions <= regions_ || strata_ <= 0) return;
+    const size_t n = size_t(strata_), old = regions_;
+    regions_ = regions;
+    q_.resize(regions * n, init);
+    qf_.resize(regions * n, float(std::min(init, double(FLT_MAX))));
+    visits_.resize(regions * n, 0);
+    cdf_.resize(regions * (n + 1), 0.f);
+    for (size_t r = old; r < regions; ++r) policy(int(r), q(r), &cdf_[r * (n + 1)]);
+}
+
 void StrataTable::assign(std::vector<double> q, std::vector<uint64_t> visits,
                          const PolicyBuilder& policy) {
     q_ = std::move(q);

@@ -23,6 +23,10 @@ public:
     // regions x strata entries, every Q = init, no visits; CDFs built with `policy` (which
     // must depend on Q only: the first region's CDF is copied to all).
     void reset(size_t regions, int strata, double init, const PolicyBuilder& policy);
+    // Appends regions (up to `regions` in all) with every Q = init and no visits, keeping
+    // the existing ones and the counters; the new CDFs are built with `policy`. Not during a
+    // pass (between endPass and beginPass only).
+    void grow(size_t regions, double init, const PolicyBuilder& policy);
 
     size_t regions() const { return regions_; }
     int strata() const { return strata_; }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <unordered_set>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -179,6 +180,19 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
                  layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
     resetConfidence();
+    if (params_.volume && scene.hasMedia()) {
+        VolumeParams vp;
+        vp.voxelCount = params_.volumeVoxels;
+        vp.cols = params_.cols;
+        vp.rows = params_.rows;
+        vp.init = params_.init;
+        vp.epsilon = params_.epsilon;
+        vp.warmup = params_.warmup;
+        vp.alphaVisits = params_.alphaVisits;
+        vp.fixedAlpha = params_.fixedAlpha;
+        vp.maxVoxels = params_.volumeMaxVoxels;
+        volume_ = std::make_unique<VdbVolume>(vp, scene.mediaMin, scene.mediaMax);
+    }
 }
 
 VdbField::~VdbField() = default;
@@ -233,6 +247,7 @@ void VdbField::resetConfidence() {
 }
 
 float VdbField::confidence(int region) const {
+    if (const int cell = volumeCell(region); cell >= 0) return volume_->confidence(cell);
     return region >= 0 && size_t(region) < confidence_.size() ? confidence_[size_t(region)] : 0.f;
 }
 
@@ -281,6 +296,16 @@ int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
         return lookupWith(p, n, probe);
     }
     }
+}
+
+int VdbField::lookupMedium(const glm::vec3& p) const {
+    if (!volume_) return -1;
+    const int cell = volume_->lookup(p);
+    return cell < 0 ? -1 : int(table_.regions()) + cell;
+}
+
+void VdbField::requestMedium(int slot, const glm::vec3& p) {
+    if (volume_) volume_->request(slot, p);
 }
 
 template <class Probe>
@@ -351,6 +376,7 @@ glm::vec3 VdbField::strataCentre(int region, int j) const {
 }
 
 float VdbField::pdf(int region, const glm::vec3& w) const {
+    if (const int cell = volumeCell(region); cell >= 0) return volume_->pdf(cell, w);
     int j = stratumOf(region, w);
     if (j < 0) return 0.f;
     return strataProbability(table_.cdf(size_t(region)), j) *
@@ -358,6 +384,8 @@ float VdbField::pdf(int region, const glm::vec3& w) const {
 }
 
 glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut) const {
+    if (const int cell = volumeCell(region); cell >= 0)
+        return volume_->sample(cell, u, uStratum, pdfOut);
     if (!validRegion(region)) {
         *pdfOut = 0.f;
         return glm::vec3(0.f);
@@ -377,6 +405,7 @@ glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOu
 
 float VdbField::scatteredEstimate(int region,
                                   const std::function<float(const glm::vec3&)>& fcos) const {
+    if (const int cell = volumeCell(region); cell >= 0) return volume_->scatteredEstimate(cell, fcos);
     if (!validRegion(region)) return 0.f;
     const double* q = table_.q(size_t(region));
     double acc = 0.0;
@@ -388,6 +417,9 @@ float VdbField::scatteredEstimate(int region,
 }
 
 float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
+    if (const int cell = volumeCell(region); cell >= 0)
+        return volume_->scatteredEstimate(
+            cell, [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
     if (!validRegion(region) || !finite3(n)) return 0.f;
     const glm::vec3 nl = frames_[size_t(region)].toLocal(n);
     const float* q = table_.qf(size_t(region));
@@ -402,18 +434,26 @@ float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
 }
 
 float VdbField::radiance(int region, const glm::vec3& w) const {
+    if (const int cell = volumeCell(region); cell >= 0) return volume_->radiance(cell, w);
     int j = stratumOf(region, w);
     if (j < 0) return 0.f;
     return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
 }
 
-void VdbField::beginPass(int numSlots) { table_.beginPass(numSlots); }
+void VdbField::beginPass(int numSlots) {
+    table_.beginPass(numSlots);
+    if (volume_) volume_->beginPass(numSlots);
+}
 
 void VdbField::record(int slot, int region, const glm::vec3& w, float target) {
+    if (const int cell = volumeCell(region); cell >= 0) return volume_->record(slot, cell, w, target);
     table_.record(slot, region, target, [&] { return stratumOf(region, w); });
 }
 
-void VdbField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy()); }
+void VdbField::endPass() {
+    table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
+    if (volume_) volume_->endPass();
+}
 
 size_t VdbField::gridBytes() const { return size_t(grid_->grid->memUsage()); }
 
@@ -421,7 +461,7 @@ size_t VdbField::bytes() const {
     return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
            clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
            frames_.capacity() * sizeof(HemiFrame) + confidence_.capacity() * sizeof(float) +
-           3 * centreX_.capacity() * sizeof(float);
+           3 * centreX_.capacity() * sizeof(float) + (volume_ ? volume_->bytes() : 0);
 }
 
 std::string VdbField::describe() const {
@@ -430,13 +470,18 @@ std::string VdbField::describe() const {
         std::snprintf(alpha, sizeof(alpha), "visits");
     else
         std::snprintf(alpha, sizeof(alpha), "%g", params_.fixedAlpha);
-    const GuidingStats& s = table_.stats();
-    char buf[640];
+    const GuidingStats s = stats();
+    char vol[160] = "";
+    if (volume_)
+        std::snprintf(vol, sizeof(vol), "; media: %d cells of %g (%d strata), %.1f MiB",
+                      volume_->cells(), volume_->voxelSize(), volume_->strata(),
+                      double(volume_->bytes()) / (1024.0 * 1024.0));
+    char buf[800];
     std::snprintf(buf, sizeof(buf),
                   "vdb: %zu active voxels of %g (from %llu points, %llu draws), %zu normals, "
                   "%d regions (%s), %dx%d strata, alpha=%s, init=%g, epsilon=%g, cosine=%d, %.1f MiB "
                   "(grid %.2f MiB; +%.1f MiB record buffers); passes=%llu, records=%llu, "
-                  "rejected targets=%llu, rejected records=%llu",
+                  "rejected targets=%llu, rejected records=%llu%s",
                   activeVoxels(), voxelSize_, (unsigned long long)points_,
                   (unsigned long long)attempts_, clusterCount(), numRegions(),
                   params_.sphere ? "full sphere per voxel" : "two hemispheres per normal",
@@ -445,13 +490,20 @@ std::string VdbField::describe() const {
                   double(gridBytes()) / (1024.0 * 1024.0),
                   double(scratchBytes()) / (1024.0 * 1024.0), (unsigned long long)s.passes,
                   (unsigned long long)s.records, (unsigned long long)s.rejectedTargets,
-                  (unsigned long long)s.rejectedRecords);
+                  (unsigned long long)s.rejectedRecords, vol);
     return buf;
 }
 
 GuidingStats VdbField::stats() const {
     GuidingStats s = table_.stats();
     s.activeVoxels = activeVoxels();
+    if (volume_) {
+        const GuidingStats& v = volume_->stats();
+        s.records += v.records;
+        s.rejectedTargets += v.rejectedTargets;
+        s.rejectedRecords += v.rejectedRecords;
+        s.mediumCells = uint64_t(volume_->cells());
+    }
     return s;
 }
 
@@ -488,6 +540,21 @@ bool VdbField::save(const std::string& path, std::string* error) const {
         copy->insertMeta("rlpbrt:records", openvdb::Int64Metadata(int64_t(s.records)));
         copy->insertMeta("rlpbrt:rejected_targets", openvdb::Int64Metadata(int64_t(s.rejectedTargets)));
         copy->insertMeta("rlpbrt:rejected_records", openvdb::Int64Metadata(int64_t(s.rejectedRecords)));
+        if (volume_) {
+            fieldio::Writer coords, counters;
+            for (const glm::ivec3& c : volume_->cellCoords())
+                coords.u32(uint32_t(c.x)), coords.u32(uint32_t(c.y)), coords.u32(uint32_t(c.z));
+            const GuidingStats& vs = volume_->stats();
+            counters.u64(vs.records), counters.u64(vs.rejectedTargets),
+                counters.u64(vs.rejectedRecords);
+            copy->insertMeta("rlpbrt:volume_voxel_size", openvdb::DoubleMetadata(volume_->voxelSize()));
+            copy->insertMeta("rlpbrt:volume_cells", openvdb::StringMetadata(coords.data));
+            copy->insertMeta("rlpbrt:volume_q",
+                             openvdb::StringMetadata(fieldio::packDoubles(volume_->table().qTable())));
+            copy->insertMeta("rlpbrt:volume_visits",
+                             openvdb::StringMetadata(fieldio::packU64(volume_->table().visitTable())));
+            copy->insertMeta("rlpbrt:volume_counters", openvdb::StringMetadata(counters.data));
+        }
         const std::string tmp = path + ".tmp";
         {
             openvdb::io::File file(tmp);
@@ -621,6 +688,47 @@ bool VdbField::load(const std::string& path, std::string* error) {
         s.records = uint64_t(grid->metaValue<int64_t>("rlpbrt:records"));
         s.rejectedTargets = uint64_t(grid->metaValue<int64_t>("rlpbrt:rejected_targets"));
         s.rejectedRecords = uint64_t(grid->metaValue<int64_t>("rlpbrt:rejected_records"));
+        // The medium vertices' tables: present iff this field has them.
+        const bool fileVolume = bool(grid->getMetadata<openvdb::StringMetadata>("rlpbrt:volume_cells"));
+        if (fileVolume != bool(volume_))
+            return fail(fileVolume ? "the file holds medium tables, this field has none (volume=0)"
+                                   : "the file has no medium tables, this field has (volume=1)");
+        std::vector<glm::ivec3> vcoords;
+        std::vector<double> vq;
+        std::vector<uint64_t> vvisits;
+        GuidingStats vstats;
+        if (volume_) {
+            const double vh = grid->metaValue<double>("rlpbrt:volume_voxel_size");
+            if (vh != volume_->voxelSize())
+                return fail("medium voxel size " + std::to_string(vh) + ", this field has " +
+                            std::to_string(volume_->voxelSize()) + " (use the same volume-voxel)");
+            const std::string cb = grid->metaValue<std::string>("rlpbrt:volume_cells");
+            if (cb.size() % 12 != 0) return fail("corrupt medium cell table");
+            const size_t cells = cb.size() / 12;
+            const glm::ivec3 dims = volume_->dims();
+            fieldio::Reader r(cb);
+            std::unordered_set<uint64_t> seenCells;
+            for (size_t i = 0; i < cells; ++i) {
+                const uint32_t x = r.u32(), y = r.u32(), z = r.u32();
+                if (x >= uint32_t(dims.x) || y >= uint32_t(dims.y) || z >= uint32_t(dims.z) ||
+                    !seenCells.insert(x + uint64_t(dims.x) * (y + uint64_t(dims.y) * z)).second)
+                    return fail("corrupt medium cell table");
+                vcoords.emplace_back(int(x), int(y), int(z));
+            }
+            const size_t n = cells * size_t(volume_->strata());
+            if (!fieldio::unpackDoubles(grid->metaValue<std::string>("rlpbrt:volume_q"), n, &vq) ||
+                !fieldio::unpackU64(grid->metaValue<std::string>("rlpbrt:volume_visits"), n,
+                                    &vvisits))
+                return fail("corrupt medium Q or visit table");
+            for (double d : vq)
+                if (!(d >= 0.0) || !std::isfinite(d)) return fail("corrupt medium Q table");
+            fieldio::Reader cr2(grid->metaValue<std::string>("rlpbrt:volume_counters"));
+            vstats.records = cr2.u64();
+            vstats.rejectedTargets = cr2.u64();
+            vstats.rejectedRecords = cr2.u64();
+            vstats.passes = s.passes;
+            if (!cr2.ok()) return fail("corrupt medium counters");
+        }
         // Commit.
         grid->clearMetadata();
         grid->setName(kGridName);
@@ -633,6 +741,7 @@ bool VdbField::load(const std::string& path, std::string* error) {
         resetConfidence();
         table_.assign(std::move(q), std::move(visits), policy());
         table_.stats() = s;
+        if (volume_) volume_->restore(vcoords, std::move(vq), std::move(vvisits), vstats);
     } catch (const std::exception& e) {
         return fail(std::string("missing or bad metadata: ") + e.what());
     }

@@ -14,6 +14,7 @@
 #include "guiding/directional.h"
 #include "guiding/guiding.h"
 #include "guiding/strata_table.h"
+#include "guiding/vdb_volume.h"
 
 namespace rlpbrt::guiding {
 
@@ -32,6 +33,9 @@ struct VdbParams {
     int normals = 4;          // at most this many dominant normals (hemisphere pairs) a voxel
     double normalAngleDeg = 30;  // normal clustering angle and lookup's admissible deviation
     double warmup = 16.0;     // confidence = visits / (visits + warmup * strata), as hemi
+    bool volume = true;       // guide at medium vertices (when the scene has media)
+    int volumeVoxels = 32;    // volume voxels along the longest axis of the media bounds
+    uint64_t volumeMaxVoxels = uint64_t(1) << 20;  // from max-mb
 };
 
 // The voxel edge and surface-sample count the parameters give for a scene.
@@ -49,6 +53,8 @@ public:
     VdbField& operator=(const VdbField&) = delete;
 
     int lookup(const glm::vec3& p, const glm::vec3& n) const override;
+    int lookupMedium(const glm::vec3& p) const override;
+    void requestMedium(int slot, const glm::vec3& p) override;
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const override;
     float pdf(int region, const glm::vec3& w) const override;
     float scatteredEstimate(int region,
@@ -97,6 +103,9 @@ public:
     const std::vector<uint64_t>& visitTable() const { return table_.visitTable(); }
     const std::vector<float>& cdfTable() const { return table_.cdfTable(); }
     size_t scratchBytes() const { return table_.scratchBytes(); }
+    // The medium vertices' tables (nullptr: no media or volume=0); their regions follow the
+    // surface regions: region = numRegions() + cell.
+    const VdbVolume* volume() const { return volume_.get(); }
     // Bytes of the OpenVDB tree alone.
     size_t gridBytes() const;
     // How lookup() reads the grid (benchmarks; not thread-safe against running lookups):
@@ -110,6 +119,10 @@ public:
 private:
     struct Grid;  // the OpenVDB grid, defined in vdb.cpp
     bool validRegion(int region) const { return region >= 0 && size_t(region) < table_.regions(); }
+    // The volume cell of a region past the surface regions, else -1.
+    int volumeCell(int region) const {
+        return region >= 0 && volume_ && size_t(region) >= table_.regions() ? region - int(table_.regions()) : -1;
+    }
     void buildPolicy(const double* q, float* cdf) const;
     StrataTable::PolicyBuilder policy() const;
     void buildFrames();
@@ -138,6 +151,7 @@ private:
     void resetConfidence();
     std::vector<float> centreX_, centreY_, centreZ_;  // local stratum centres (all strata)
     StrataTable table_;
+    std::unique_ptr<VdbVolume> volume_;
     Accessor accessor_ = Accessor::Hybrid;
     template <class Probe>
     int lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) const;

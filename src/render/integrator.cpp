@@ -67,6 +67,8 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     info.boundsMin = scene.boundsMin();
     info.boundsMax = scene.boundsMax();
     info.totalArea = scene.totalSurfaceArea();
+    Vec3 mediaMin, mediaMax;
+    if (scene.mediaBounds(&mediaMin, &mediaMax)) info.mediaMin = mediaMin, info.mediaMax = mediaMax;
     const Scene* sc = &scene;
     info.samplePoint = [sc](const glm::vec3& u, glm::vec3* p, glm::vec3* n) {
         return sc->sampleSurface(u, p, n);
@@ -198,7 +200,37 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
     return tr;
 }
 
-Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g,
+float PathIntegrator::mediumDirectionPdf(const Vec3& wo, float g, int region,
+                                         const Vec3& wi) const {
+    const float phase = henyeyGreenstein(glm::dot(wo, wi), g);
+    const float mix = regionMix(region);
+    return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * phase : phase;
+}
+
+PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
+                                                                      int region,
+                                                                      Sampler& sampler) const {
+    DirectionSample ds;
+    const float uc = guide_.field ? sampler.get1D() : 1.f;
+    const Vec2 u = sampler.get2D();
+    const float mix = regionMix(region);
+    float pGuide = 0.f, pPhase = 0.f;
+    if (uc < mix) {
+        ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide);
+        if (!(pGuide > 0.f)) return DirectionSample();
+        pPhase = henyeyGreenstein(glm::dot(wo, ds.wi), g);
+    } else {
+        ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
+        if (!(pPhase > 0.f)) return DirectionSample();
+        if (mix > 0.f) pGuide = guide_.field->pdf(region, ds.wi);
+    }
+    ds.f = Spectrum(pPhase);
+    ds.pdf = mix * pGuide + (1.f - mix) * pPhase;
+    if (!(ds.pdf > 0.f) || !std::isfinite(ds.pdf)) return DirectionSample();
+    return ds;
+}
+
+Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g, int region,
                                            const PathMedium& pm, Sampler& sampler,
                                            PathStats& stats) const {
     float uLight = sampler.get1D();
@@ -216,7 +248,8 @@ Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float 
     if (isBlack(tr)) return Spectrum(0.f);
     if (ls.isDelta) return phase * tr * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1, phase);
+    float w = powerHeuristic(1, lightPdf, 1,
+                             region >= 0 ? mediumDirectionPdf(wo, g, region, ls.wi) : phase);
     return phase * tr * ls.L * (w / lightPdf);
 }
 
@@ -285,17 +318,40 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             MediumSample ms = medium.sample(ray.o, ray.d, found ? si.t : ray.tMax, rng);
             beta *= ms.weight;
             if (isBlack(beta) || !isFinite(beta)) break;
+            // The pending target is radiance arriving at its vertex: weighted by the flight.
+            if (pending.active()) pending.weight *= luminance(ms.weight);
             if (ms.scattered) {
-                // A medium vertex: NEE with MIS against the phase function, then a phase
-                // sample (guiding acts only at surface vertices for now).
-                pending = PendingRecord();
+                // A medium vertex: NEE with MIS against the direction sampling, then a
+                // direction from the phase function, mixed with the guide where the field
+                // has a volume cell (the field is asked to model this place otherwise).
                 if (bounces >= maxDepth_) break;
                 Vec3 p = ray.o + ms.t * ray.d, wo = -ray.d;
-                L += beta * sampleLightMedium(p, wo, medium.g(), pm, sampler, stats);
-                float phasePdf;
-                Vec3 wi = sampleHenyeyGreenstein(wo, medium.g(), sampler.get2D(), &phasePdf);
-                if (!(phasePdf > 0.f)) break;
-                dirPdf = phasePdf;  // the sample weight phase / pdf is 1
+                int region = -1;
+                if (field) {
+                    region = field->lookupMedium(p);
+                    if (region < 0 && learn) field->requestMedium(slot, p);
+                }
+                const int sampleRegion = guide_.mix > 0.f ? region : -1;
+                ++stats.vertices;
+                L += beta * sampleLightMedium(p, wo, medium.g(), sampleRegion, pm, sampler, stats);
+                DirectionSample ds = sampleMediumDirection(wo, medium.g(), sampleRegion, sampler);
+                if (learn) {
+                    // Eq. 1 for the previous vertex, with the one-sample estimate of the
+                    // light scattered here: Q(p, w') phase(w') / pdf(w').
+                    if (pending.active() && region >= 0 && ds.pdf > 0.f) {
+                        const float est = field->radiance(region, ds.wi) * ds.f.x / ds.pdf;
+                        flush(std::isfinite(est) ? est : 0.f);
+                    }
+                    pending = PendingRecord();
+                    if (region >= 0 && ds.pdf > 0.f) {
+                        pending.region = region;
+                        pending.w = ds.wi;
+                    }
+                }
+                if (!(ds.pdf > 0.f)) break;
+                const Vec3 wi = ds.wi;
+                beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
+                dirPdf = ds.pdf;
                 specularBounce = false;
                 prev = LightSampleContext{p, Vec3(0.f)};
                 ray = Ray(p, wi);

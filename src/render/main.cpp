@@ -284,6 +284,7 @@ int main(int argc, char** argv) {
             j["guide_rejected_targets"] = gs.rejectedTargets;
             j["guide_mix"] = mix;
             if (guide == "vdb") j["guide_active_voxels"] = gs.activeVoxels;
+            if (gs.mediumCells) j["guide_medium_cells"] = gs.mediumCells;
         }
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;

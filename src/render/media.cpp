@@ -27,6 +27,8 @@ Vec3 sampleHenyeyGreenstein(const Vec3& wo, float g, Vec2 u, float* pdf) {
 
 Medium::~Medium() = default;
 
+bool Medium::worldBounds(Vec3*, Vec3*) const { return false; }
+
 // ------------------------------------------------------------------------------------------
 // Homogeneous.
 
@@ -70,8 +72,31 @@ DensityMediumBase::DensityMediumBase(const Spectrum& sigmaA, const Spectrum& sig
                                      const Mat4& worldFromLocal, const Vec3& boxMin,
                                      const Vec3& boxMax)
     : sigmaS_(sigmaS), sigmaT_((sigmaA + sigmaS).x), localFromWorld_(glm::inverse(worldFromLocal)),
-      boxMin_(boxMin), boxMax_(boxMax) {
+      worldFromLocal_(worldFromLocal), boxMin_(boxMin), boxMax_(boxMax) {
     g_ = g;
+}
+
+bool DensityMediumBase::worldBounds(Vec3* lo, Vec3* hi) const {
+    *lo = Vec3(Infinity);
+    *hi = Vec3(-Infinity);
+    if (!(sigmaT_ > 0.f) || !(maxComponent(sigmaS_) > 0.f)) return true;
+    glm::ivec3 a(res_), b(-1);  // range of cells with a non-zero majorant
+    for (int z = 0; z < res_.z; ++z)
+        for (int y = 0; y < res_.y; ++y)
+            for (int x = 0; x < res_.x; ++x)
+                if (majorant(x, y, z) > 0.f) {
+                    a = glm::min(a, glm::ivec3(x, y, z));
+                    b = glm::max(b, glm::ivec3(x, y, z));
+                }
+    if (b.x < 0) return true;
+    const Vec3 l = boxMin_ + Vec3(a) * cellSize_, h = boxMin_ + Vec3(b + 1) * cellSize_;
+    for (int c = 0; c < 8; ++c) {
+        Vec3 corner((c & 1) ? h.x : l.x, (c & 2) ? h.y : l.y, (c & 4) ? h.z : l.z);
+        Vec3 w = transformPoint(worldFromLocal_, corner);
+        *lo = glm::min(*lo, w);
+        *hi = glm::max(*hi, w);
+    }
+    return true;
 }
 
 bool DensityMediumBase::clip(const Vec3& o, const Vec3& d, float tMax, Vec3* oL, Vec3* dL,

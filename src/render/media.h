@@ -74,6 +74,9 @@ public:
     // Unbiased estimate of the transmittance of the segment o + t d, t in (0, tMax].
     virtual Spectrum tr(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const = 0;
     float g() const { return g_; }
+    // A world-space box outside which the medium cannot scatter (*lo > *hi when it never
+    // does); false when it fills all space (homogeneous media).
+    virtual bool worldBounds(Vec3* lo, Vec3* hi) const;
 
 protected:
     float g_ = 0.f;
@@ -101,6 +104,8 @@ public:
     DensityMediumBase(const Spectrum& sigmaA, const Spectrum& sigmaS, float g,
                       const Mat4& worldFromLocal, const Vec3& boxMin, const Vec3& boxMax);
     float maxDensity() const { return maxDensity_; }
+    // The world box of the majorant cells with a non-zero bound.
+    bool worldBounds(Vec3* lo, Vec3* hi) const override;
     float sigmaT() const { return sigmaT_; }
     // The majorant grid: resolution and the bound of one cell.
     glm::ivec3 majorantResolution() const { return res_; }
@@ -125,7 +130,7 @@ protected:
 
     Spectrum sigmaS_;
     float sigmaT_ = 0.f;
-    Mat4 localFromWorld_{1.f};
+    Mat4 localFromWorld_{1.f}, worldFromLocal_{1.f};
     Vec3 boxMin_{0.f}, boxMax_{1.f};
     float maxDensity_ = 0.f;
     glm::ivec3 res_{1, 1, 1};

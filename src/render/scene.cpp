@@ -333,6 +333,19 @@ bool Scene::sampleSurface(const Vec3& u, Vec3* p, Vec3* n) const {
     return isFinite(*p) && isFinite(*n);
 }
 
+bool Scene::mediaBounds(Vec3* lo, Vec3* hi) const {
+    *lo = Vec3(Infinity);
+    *hi = Vec3(-Infinity);
+    for (const auto& m : media) {
+        Vec3 a, b;
+        if (!m->worldBounds(&a, &b)) a = bMin_, b = bMax_;
+        if (!(a.x <= b.x && a.y <= b.y && a.z <= b.z)) continue;
+        *lo = glm::min(*lo, a);
+        *hi = glm::max(*hi, b);
+    }
+    return lo->x <= hi->x && lo->y <= hi->y && lo->z <= hi->z && isFinite(*lo) && isFinite(*hi);
+}
+
 double Scene::totalSurfaceArea() const {
     std::call_once(areaOnce_, [this] { buildAreaTables(); });
     return totalArea_;

@@ -99,6 +99,9 @@ public:
     std::vector<std::unique_ptr<Medium>> media;
     int cameraMedium = -1;
     bool hasMedia() const { return !media.empty(); }
+    // A box bounding where the media can scatter (the scene bounds for media that fill all
+    // space); false when nothing scatters.
+    bool mediaBounds(Vec3* lo, Vec3* hi) const;
     std::unique_ptr<Camera> camera;
     std::shared_ptr<const Filter> filter;
     FilmParams filmParams;
