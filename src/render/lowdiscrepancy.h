@@ -64,6 +64,18 @@ inline uint32_t sobolDim1(uint32_t i) {
     return v;
 }
 
+// sobolDim1 with its bits reversed, without a loop: bit j of the result is the XOR of the
+// index bits k whose positions are bitwise supersets of j (Lucas: C(k, j) is odd iff j is a
+// subset of k), the superset-sum transform over the 5 position bits.
+inline uint32_t sobolDim1Reversed(uint32_t i) {
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return i;
+}
+
 // Bijection of 32-bit words in which output bit j depends only on input bits 0..j and the
 // seed (additions and x ^= x * even only carry upwards). Applied to bit-reversed values it is
 // a nested uniform (Owen) scramble; the fixed multipliers were chosen by a search over random

@@ -23,7 +23,6 @@ inline uint64_t dimHash(uint64_t key, uint32_t dim) {
 // Two seeds for the Owen scrambles of the x and y values of one dimension hash.
 inline uint64_t scrambleSeedX(uint64_t h) { return mixBits(h ^ 0x5851f42d4c957f2dULL); }
 inline uint64_t scrambleSeedY(uint64_t h) { return mixBits(h ^ 0x14057b7ef767814fULL); }
-
 // Seed of a guided render's pass: independent streams per pass.
 inline uint64_t passSeed(uint64_t seed, int pass) {
     return hashCombine(seed ^ 0x243f6a8885a308d3ULL, uint64_t(uint32_t(pass)));
@@ -107,12 +106,16 @@ void PaddedSobolSampler::startPixelSample(int px, int py, int sampleIndex, int d
     key_ = pixelKey(seed_, px, py);
     base_ = s - s % n;
     index_ = s % n;
+    // A fresh permutation per block of spp samples (blocks after the first are rendered by
+    // --time runs): the same one in every block would pair the dimensions' strata
+    // identically in each block (cloud, 413 spp timed: relMSE 0.00070 against 0.00036).
+    blockSeed_ = base_ == 0 ? 0 : mixBits(uint64_t(s / n) * GoldenGamma);
     dim_ = uint32_t(dim);
 }
 
 float PaddedSobolSampler::get1D() {
     const uint64_t h = dimHash(key_, dim_++);
-    const uint32_t i = base_ + permutationElement(index_, uint32_t(spp_), h);
+    const uint32_t i = base_ + permutationElement(index_, uint32_t(spp_), h ^ blockSeed_);
     // owenScramble(sobolDim0(i)) without the two bit reversals that cancel.
     return bitsToUnitFloat(reverseBits32(ascendingHash(i, scrambleSeedX(h))));
 }
@@ -120,9 +123,10 @@ float PaddedSobolSampler::get1D() {
 Vec2 PaddedSobolSampler::get2D() {
     const uint64_t h = dimHash(key_, dim_);
     dim_ += 2;
-    const uint32_t i = base_ + permutationElement(index_, uint32_t(spp_), h);
+    const uint32_t i = base_ + permutationElement(index_, uint32_t(spp_), h ^ blockSeed_);
     const uint32_t x = reverseBits32(ascendingHash(i, scrambleSeedX(h)));
-    const uint32_t y = owenScramble(sobolDim1(i), scrambleSeedY(h));
+    // owenScramble(sobolDim1(i)), again without the reversals that cancel.
+    const uint32_t y = reverseBits32(ascendingHash(sobolDim1Reversed(i), scrambleSeedY(h)));
     return Vec2(bitsToUnitFloat(x), bitsToUnitFloat(y));
 }
 

@@ -89,9 +89,10 @@ private:
 };
 
 // Owen-scrambled Sobol' (0,2)-sequence, padded per dimension: each get1D/get2D takes the
-// first one/two Sobol' dimensions at an index shuffled by a per-(pixel, dimension) random
-// permutation of the pixel's sample indices, Owen-scrambled with per-(pixel, dimension)
-// seeds. For power-of-two spp each 2D pair of a pixel's spp samples is a (0,m,2)-net and
+// first one/two Sobol' dimensions at an index shuffled by a per-(pixel, dimension, block of
+// spp samples) random permutation of the block's indices, Owen-scrambled with per-(pixel,
+// dimension) seeds (the same for all blocks, so consecutive blocks continue one scrambled
+// sequence). For power-of-two spp each 2D pair of a pixel's spp samples is a (0,m,2)-net and
 // each 1D dimension has one sample per 1/spp interval; other spp take the first spp points
 // of the (0,2)-sequence. Serves "sobol", "02sequence", "maxmindist" and "halton".
 class PaddedSobolSampler final : public Sampler {
@@ -112,6 +113,7 @@ private:
     uint64_t key_ = 0;      // hash of (seed, pixel)
     uint32_t base_ = 0;     // (sampleIndex / spp) * spp: first Sobol' index of the block
     uint32_t index_ = 0;    // sampleIndex % spp
+    uint64_t blockSeed_ = 0;  // varies the permutations per block (0 for the first)
     uint32_t dim_ = 0;
 };
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <thread>
+#include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -299,6 +300,31 @@ TEST(Sampler, SobolFamilyPointSetsAreZeroMTwoNets) {
                     for (int c : c1) ASSERT_EQ(c, 1) << name << " n=" << n << " dim=" << dim;
                 }
             }
+        }
+    }
+}
+
+// A --time render continues past pixelsamples with further blocks of spp samples: each block
+// must pair the dimensions afresh. Two 1D dimensions over 32 blocks of 16: 512 points in the
+// 16 x 16 cells of their coarse strata. The same permutation in every block puts them in the
+// same 16 cells; fresh random pairings fill about 256 (1 - e^-2) = 221 of them.
+TEST(Sampler, BlocksPastPixelSamplesPairDimensionsAfresh) {
+    for (const char* name : {"sobol", "02sequence", "halton"}) {
+        auto s = make(name, 16, 9);
+        for (int dim : {3, 40}) {
+            std::set<int> cells;
+            std::vector<float> a, b;
+            for (int i = 0; i < 512; ++i) {
+                s->startPixelSample(6, 1, i, dim);
+                const float u = s->get1D(), v = s->get1D();
+                cells.insert(int(u * 16) * 16 + int(v * 16));
+                a.push_back(u);
+            }
+            EXPECT_GT(cells.size(), 190u) << name << " dim " << dim;
+            // The blocks together are still the sequence's first 512 points: stratified.
+            std::vector<int> c1(512, 0);
+            for (float v : a) ++c1[size_t(v * 512)];
+            for (int c : c1) ASSERT_EQ(c, 1) << name;
         }
     }
 }
