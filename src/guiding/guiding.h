@@ -131,7 +131,7 @@ public:
 //   alpha        "visits" (default: 1/(1+visits), batch running mean) or a number in (0,1]
 //   strata       "WxH" (default 8x8): W columns in phi, H rows in cos(theta), each 1..64;
 //                "N" means NxN
-//   points       surface samples, 1..2^26 (default 8192); each gives two hemispheres (n, -n)
+//   points       surface samples, 1..2^26 (default 2048); each gives two hemispheres (n, -n)
 //   normal-angle admissible normal deviation in degrees, (0, 180) (default 30)
 //   init         initial Q, positive and <= 3.4e38 (default 1e-3)
 //   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)

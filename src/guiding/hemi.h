@@ -23,7 +23,12 @@ struct HemiParams {
     bool alphaVisits = true;     // alpha = 1/(1 + visits) if true, else fixedAlpha
     double fixedAlpha = 1.0;     // in (0, 1]
     int cols = 8, rows = 8;      // strata in phi and in cos(theta)
-    uint64_t points = 8192;      // surface samples (two hemispheres each)
+    // Surface samples (two hemispheres each). Fewer regions learn faster: measured relMSE
+    // (64 spp, seeds 2/3/4) veach-bidir 0.255/0.307/0.279 with 8192 points against
+    // 0.185/0.195/0.191 with 2048 (and 0.0644 against 0.0475 at 256 spp), breakfast
+    // 6.92/6.28 against 5.28/5.66, killeroo 0.00053/0.00052 against 0.00051/0.00050,
+    // buddha-fractal 0.0225/0.0232 against 0.0226/0.0231 (docs/BENCHMARKS.md).
+    uint64_t points = 2048;
     double normalAngleDeg = 30;  // admissible normal deviation
     double init = 1e-3;          // initial Q
     double epsilon = 0.1;        // uniform share of every CDF

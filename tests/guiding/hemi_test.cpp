@@ -189,13 +189,13 @@ TEST(GuidingFactory, NoneAndErrors) {
 TEST(HemiField, DefaultsAndMemory) {
     auto f = makeHemi(planeScene());
     ASSERT_TRUE(f);
-    EXPECT_EQ(f->numRegions(), 2 * 8192);
+    EXPECT_EQ(f->numRegions(), 2 * 2048);
     EXPECT_EQ(f->layout().count(), 64);
     EXPECT_TRUE(f->params().alphaVisits);
     // Q (double), visits (uint64), CDF (65 floats), frame and moment per region dominate.
     const size_t tables = size_t(f->numRegions()) * (64 * 20 + 65 * 4 + 64);
     EXPECT_GE(f->bytes(), tables);
-    EXPECT_LE(f->bytes(), tables + 8192 * 64);
+    EXPECT_LE(f->bytes(), tables + 2048 * 64);
     EXPECT_LE(double(f->bytes()), 1.05 * hemiEstimatedBytes(f->params()));
     EXPECT_FALSE(f->describe().empty());
     // Record buffers are scratch, reported apart from the learned data.
