@@ -85,6 +85,17 @@ Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w, float smallScale) 
     return offsetRayOrigin(si.p, glm::dot(w, si.ng) > 0.f ? si.ng : -si.ng, smallScale);
 }
 
+// The share of a guidable BSDF's lobes that are diffuse: the guide's table (Q cos, no BSDF
+// product) suits diffuse lobes; a glossy lobe is narrower than a stratum and is better
+// sampled by the BSDF. The integrator scales its guide probability by this share.
+float diffuseShare(const BSDF& bsdf) {
+    const int all = bsdf.numComponents();
+    return all > 0 ? float(bsdf.numComponents(BxDFFlags::Reflection | BxDFFlags::Transmission |
+                                              BxDFFlags::Diffuse)) /
+                         float(all)
+                   : 0.f;
+}
+
 // A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide).
 // (numComponents counts lobes whose flags are all among the requested ones, so "specular
 // lobes" are the lobes not counted without the Specular bit.)
@@ -104,16 +115,16 @@ struct PendingRecord {
 };
 }  // namespace
 
-float PathIntegrator::directionPdf(const BSDF& bsdf, int region, const Vec3& wo,
+float PathIntegrator::directionPdf(const BSDF& bsdf, int region, float mix, const Vec3& wo,
                                    const Vec3& wi) const {
     float pb = bsdf.pdf(wo, wi);
     if (region < 0) return pb;
-    const float mix = regionMix(region);
     return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * pb : pb;
 }
 
 PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
                                                                 const BSDF& bsdf, int region,
+                                                                float mix,
                                                                 Sampler& sampler) const {
     DirectionSample ds;
     float uc = sampler.get1D();
@@ -129,7 +140,6 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
-    const float mix = regionMix(region);
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
@@ -153,7 +163,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
 }
 
 Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                     Sampler& sampler, PathStats& stats,
+                                     float mix, Sampler& sampler, PathStats& stats,
                                      const PathMedium* media) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
@@ -178,7 +188,7 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     }
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, si.wo, ls.wi));
+    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, mix, si.wo, ls.wi));
     return f * ls.L * (w / lightPdf);
 }
 
@@ -420,13 +430,17 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             region = field->lookup(si.p, nFacing);
         }
         const bool lastVertex = bounces >= maxDepth_;
-        const int sampleRegion = guide_.mix > 0.f ? region : -1;
+        // The guide's probability here: mix x the region's confidence x the diffuse share.
+        const float vertexMix = region >= 0 && guide_.mix > 0.f
+                                    ? regionMix(region) * diffuseShare(bsdf)
+                                    : 0.f;
+        const int sampleRegion = vertexMix > 0.f ? region : -1;
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
         if (!lastVertex) {
             ++stats.vertices;
             if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
-                L += beta * sampleLight(si, bsdf, sampleRegion, sampler, stats,
+                L += beta * sampleLight(si, bsdf, sampleRegion, vertexMix, sampler, stats,
                                         media ? &pm : nullptr);
         }
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
@@ -445,7 +459,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         if (lastVertex) break;
         // Sample the next direction (the guiding seam).
-        DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, sampler);
+        DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, vertexMix, sampler);
         if (deferTarget) {
             // One-sample estimate of the Eq. 1 sum: Q(y, w') f(w') cos / pdf(w').
             float est = 0.f;

@@ -61,9 +61,11 @@ private:
         bool specular = false;
         bool transmission = false;
     };
+    // `mix`: the probability of a guided sample at this vertex (0 or region < 0: BSDF only).
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                    Sampler& sampler) const;
-    float directionPdf(const BSDF& bsdf, int region, const Vec3& wo, const Vec3& wi) const;
+                                    float mix, Sampler& sampler) const;
+    float directionPdf(const BSDF& bsdf, int region, float mix, const Vec3& wo,
+                       const Vec3& wi) const;
     // Probability of a guided sample at a region: the mix setting times the region's
     // confidence (0 without a region).
     float regionMix(int region) const {
@@ -74,7 +76,7 @@ private:
         int medium = -1;
         Rng* rng = nullptr;
     };
-    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region, float mix,
                          Sampler& sampler, PathStats& stats,
                          const PathMedium* media = nullptr) const;
     // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
