@@ -53,7 +53,7 @@ double vdbVoxelSize(const VdbParams& params, const SceneInfo& scene) {
     if (!(longest > 0.0)) return 1.0;
     if (params.voxelCount > 0) return longest / params.voxelCount;
     double h = scene.totalArea > 0.0 && std::isfinite(scene.totalArea)
-                   ? std::sqrt(scene.totalArea / 4096.0)
+                   ? std::sqrt(scene.totalArea / 1024.0)
                    : longest / 64.0;
     return std::clamp(h, longest / 1024.0, longest / 4.0);
 }

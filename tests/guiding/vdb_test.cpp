@@ -167,11 +167,11 @@ TEST(VdbFactory, ParametersAndErrors) {
 TEST(VdbField, DefaultVoxelSizeFromScene) {
     auto f = makeVdb(planeScene());
     ASSERT_TRUE(f);
-    // sqrt(area / 4096) = 1/64 for the unit square, within [1/1024, 1/4].
-    EXPECT_DOUBLE_EQ(f->voxelSize(), 1.0 / 64.0);
+    // sqrt(area / 1024) = 1/32 for the unit square, within [1/1024, 1/4].
+    EXPECT_DOUBLE_EQ(f->voxelSize(), 1.0 / 32.0);
     EXPECT_EQ(f->pointCount(), 65536u);
-    EXPECT_EQ(f->activeVoxels(), 64u * 64u);
-    EXPECT_EQ(f->stats().activeVoxels, 64u * 64u);
+    EXPECT_EQ(f->activeVoxels(), 32u * 32u);
+    EXPECT_EQ(f->stats().activeVoxels, 32u * 32u);
     EXPECT_GT(f->bytes(), f->gridBytes());
     EXPECT_LE(double(f->bytes()), vdbEstimatedBytes(f->params(), planeScene()));
 }
