@@ -25,21 +25,11 @@ namespace {
 using test::cornerScene;
 using test::gaussianDirection;
 using test::planeScene;
+using test::trainBright;
 
 std::unique_ptr<HemiField> makeHemi(const SceneInfo& scene,
                                     std::map<std::string, std::string> params = {}) {
-    GuideConfig cfg;
-    cfg.backend = "hemi";
-    cfg.params = std::move(params);
-    std::string error;
-    std::unique_ptr<GuidingField> f = createGuidingField(cfg, scene, &error);
-    EXPECT_TRUE(f) << error;
-    EXPECT_TRUE(error.empty()) << error;
-    auto* hemi = dynamic_cast<HemiField*>(f.get());
-    EXPECT_TRUE(hemi);
-    if (!hemi) return nullptr;
-    f.release();
-    return std::unique_ptr<HemiField>(hemi);
+    return test::makeField<HemiField>("hemi", scene, std::move(params));
 }
 
 // World direction of stratum j's centre in a region.
@@ -105,20 +95,6 @@ chi2::Result strataTest(const HemiField& f, int region, uint64_t seed, int sampl
         for (int k = 0; k < 4; ++k) expected[size_t(4 * j + k)] = samples * pj / 4.0;
     }
     return chi2::testCounts(observed, expected);
-}
-
-// Trains a region for a few passes towards a bright cone around `bright`.
-void trainBright(HemiField& f, int region, const glm::vec3& bright, int passes, uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    for (int p = 0; p < passes; ++p) {
-        f.beginPass(1);
-        for (int i = 0; i < 20000; ++i) {
-            glm::vec3 w = gaussianDirection(rng);
-            float target = glm::dot(w, bright) > 0.9f ? 100.f : 0.05f;
-            f.record(0, region, w, target);  // half of them are below the hemisphere
-        }
-        f.endPass();
-    }
 }
 
 TEST(GuidingFactory, NoneAndErrors) {

@@ -1,7 +1,12 @@
 // Small analytic scenes and random directions shared by the guiding backends' tests.
 #pragma once
 
+#include <map>
+#include <memory>
 #include <random>
+#include <string>
+
+#include <gtest/gtest.h>
 
 #include "guiding/guiding.h"
 
@@ -48,6 +53,40 @@ inline glm::vec3 gaussianDirection(std::mt19937_64& rng) {
         v = glm::vec3(g(rng), g(rng), g(rng));
     } while (glm::length(v) < 1e-6f);
     return glm::normalize(v);
+}
+
+// A field of backend Field made through the factory (as the integrator does); a test failure
+// and nullptr if the factory refuses or makes another type.
+template <class Field>
+std::unique_ptr<Field> makeField(const char* backend, const SceneInfo& scene,
+                                 std::map<std::string, std::string> params = {}) {
+    GuideConfig cfg;
+    cfg.backend = backend;
+    cfg.params = std::move(params);
+    std::string error;
+    std::unique_ptr<GuidingField> f = createGuidingField(cfg, scene, &error);
+    EXPECT_TRUE(f) << error;
+    EXPECT_TRUE(error.empty()) << error;
+    auto* typed = dynamic_cast<Field*>(f.get());
+    EXPECT_TRUE(typed);
+    if (!typed) return nullptr;
+    f.release();
+    return std::unique_ptr<Field>(typed);
+}
+
+// Trains a region for a few passes of 20000 uniform directions: target 100 within the cone
+// dot(w, bright) > 0.9, 0.05 elsewhere (directions outside the region's strata are rejected).
+inline void trainBright(GuidingField& f, int region, const glm::vec3& bright, int passes,
+                        uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    for (int p = 0; p < passes; ++p) {
+        f.beginPass(1);
+        for (int i = 0; i < 20000; ++i) {
+            glm::vec3 w = gaussianDirection(rng);
+            f.record(0, region, w, glm::dot(w, bright) > 0.9f ? 100.f : 0.05f);
+        }
+        f.endPass();
+    }
 }
 
 }  // namespace rlpbrt::guiding::test

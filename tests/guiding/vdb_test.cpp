@@ -30,21 +30,11 @@ namespace {
 using test::cornerScene;
 using test::gaussianDirection;
 using test::planeScene;
+using test::trainBright;
 
 std::unique_ptr<VdbField> makeVdb(const SceneInfo& scene,
                                   std::map<std::string, std::string> params = {}) {
-    GuideConfig cfg;
-    cfg.backend = "vdb";
-    cfg.params = std::move(params);
-    std::string error;
-    std::unique_ptr<GuidingField> f = createGuidingField(cfg, scene, &error);
-    EXPECT_TRUE(f) << error;
-    EXPECT_TRUE(error.empty()) << error;
-    auto* v = dynamic_cast<VdbField*>(f.get());
-    EXPECT_TRUE(v);
-    if (!v) return nullptr;
-    f.release();
-    return std::unique_ptr<VdbField>(v);
+    return test::makeField<VdbField>("vdb", scene, std::move(params));
 }
 
 // Sum over strata of pdf(centre) * stratum solid angle: the pdf's integral over the sphere.
@@ -92,20 +82,6 @@ chi2::Result strataTest(const VdbField& f, int region, uint64_t seed, int sample
         expected[size_t(j)] =
             samples * double(f.pdf(region, f.strataCentre(region, j))) * f.stratumSolidAngle();
     return chi2::testCounts(observed, expected, 0.01, kTestsPerCase);
-}
-
-void trainBright(GuidingField& f, int region, const glm::vec3& bright, int passes,
-                 uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    for (int p = 0; p < passes; ++p) {
-        f.beginPass(1);
-        for (int i = 0; i < 20000; ++i) {
-            glm::vec3 w = gaussianDirection(rng);
-            float target = glm::dot(w, bright) > 0.9f ? 100.f : 0.05f;
-            f.record(0, region, w, target);
-        }
-        f.endPass();
-    }
 }
 
 std::string tempPath(const std::string& name) {

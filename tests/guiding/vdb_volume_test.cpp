@@ -19,6 +19,12 @@ namespace {
 
 using test::gaussianDirection;
 using test::planeScene;
+using test::trainBright;
+
+std::unique_ptr<VdbField> makeVdb(const SceneInfo& scene,
+                                  std::map<std::string, std::string> params = {}) {
+    return test::makeField<VdbField>("vdb", scene, std::move(params));
+}
 
 // The unit-square plane with a medium filling [0,1]^2 x [0, 0.5] above it.
 SceneInfo foggyPlane() {
@@ -29,39 +35,11 @@ SceneInfo foggyPlane() {
     return s;
 }
 
-std::unique_ptr<VdbField> makeVdb(const SceneInfo& scene,
-                                  std::map<std::string, std::string> params = {}) {
-    GuideConfig cfg;
-    cfg.backend = "vdb";
-    cfg.params = std::move(params);
-    std::string error;
-    std::unique_ptr<GuidingField> f = createGuidingField(cfg, scene, &error);
-    EXPECT_TRUE(f) << error;
-    auto* v = dynamic_cast<VdbField*>(f.get());
-    if (!v) return nullptr;
-    f.release();
-    return std::unique_ptr<VdbField>(v);
-}
-
 // Requests the voxels of `points` in slot 0 and ends the pass.
 void activate(GuidingField& f, const std::vector<glm::vec3>& points) {
     f.beginPass(1);
     for (const glm::vec3& p : points) f.requestMedium(0, p);
     f.endPass();
-}
-
-// Records bright targets (100) around `bright` and dim ones elsewhere for `region`.
-void trainBright(GuidingField& f, int region, const glm::vec3& bright, int passes,
-                 uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    for (int p = 0; p < passes; ++p) {
-        f.beginPass(1);
-        for (int i = 0; i < 20000; ++i) {
-            glm::vec3 w = gaussianDirection(rng);
-            f.record(0, region, w, glm::dot(w, bright) > 0.9f ? 100.f : 0.05f);
-        }
-        f.endPass();
-    }
 }
 
 TEST(VdbVolume, OnlyScenesWithMediaGetTablesAndParametersAreChecked) {
