@@ -115,16 +115,17 @@ struct PendingRecord {
 };
 }  // namespace
 
-float PathIntegrator::directionPdf(const BSDF& bsdf, int region, float mix, const Vec3& wo,
+float PathIntegrator::directionPdf(const BSDF& bsdf, int region, float share, const Vec3& wo,
                                    const Vec3& wi) const {
     float pb = bsdf.pdf(wo, wi);
     if (region < 0) return pb;
+    const float mix = regionMix(region) * share;
     return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * pb : pb;
 }
 
 PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
                                                                 const BSDF& bsdf, int region,
-                                                                float mix,
+                                                                float share,
                                                                 Sampler& sampler) const {
     DirectionSample ds;
     float uc = sampler.get1D();
@@ -140,6 +141,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
+    const float mix = regionMix(region) * share;
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
@@ -163,7 +165,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
 }
 
 Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                     float mix, Sampler& sampler, PathStats& stats,
+                                     float share, Sampler& sampler, PathStats& stats,
                                      const PathMedium* media) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
@@ -188,7 +190,7 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     }
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, mix, si.wo, ls.wi));
+    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, share, si.wo, ls.wi));
     return f * ls.L * (w / lightPdf);
 }
 
@@ -431,16 +433,14 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         const bool lastVertex = bounces >= maxDepth_;
         // The guide's probability here: mix x the region's confidence x the diffuse share.
-        const float vertexMix = region >= 0 && guide_.mix > 0.f
-                                    ? regionMix(region) * diffuseShare(bsdf)
-                                    : 0.f;
-        const int sampleRegion = vertexMix > 0.f ? region : -1;
+        const float share = region >= 0 && guide_.mix > 0.f ? diffuseShare(bsdf) : 0.f;
+        const int sampleRegion = share > 0.f ? region : -1;
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
         if (!lastVertex) {
             ++stats.vertices;
             if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
-                L += beta * sampleLight(si, bsdf, sampleRegion, vertexMix, sampler, stats,
+                L += beta * sampleLight(si, bsdf, sampleRegion, share, sampler, stats,
                                         media ? &pm : nullptr);
         }
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
@@ -459,7 +459,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         if (lastVertex) break;
         // Sample the next direction (the guiding seam).
-        DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, vertexMix, sampler);
+        DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, share, sampler);
         if (deferTarget) {
             // One-sample estimate of the Eq. 1 sum: Q(y, w') f(w') cos / pdf(w').
             float est = 0.f;

@@ -61,10 +61,12 @@ private:
         bool specular = false;
         bool transmission = false;
     };
-    // `mix`: the probability of a guided sample at this vertex (0 or region < 0: BSDF only).
+    // `share`: the BSDF's diffuse share; the probability of a guided sample is
+    // regionMix(region) * share (region < 0: BSDF only). The region's confidence is read
+    // here, late, so that the lookup's prefetch of its cache line has landed.
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                    float mix, Sampler& sampler) const;
-    float directionPdf(const BSDF& bsdf, int region, float mix, const Vec3& wo,
+                                    float share, Sampler& sampler) const;
+    float directionPdf(const BSDF& bsdf, int region, float share, const Vec3& wo,
                        const Vec3& wi) const;
     // Probability of a guided sample at a region: the mix setting times the region's
     // confidence (0 without a region).
@@ -76,7 +78,7 @@ private:
         int medium = -1;
         Rng* rng = nullptr;
     };
-    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region, float mix,
+    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region, float share,
                          Sampler& sampler, PathStats& stats,
                          const PathMedium* media = nullptr) const;
     // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
