@@ -106,6 +106,20 @@ public:
     // Local unit direction of stratum j's centre (its representative direction).
     const glm::vec3& centre(int j) const { return centres_[static_cast<size_t>(j)]; }
 
+    // The full sphere as 2 count() strata: the upper hemisphere's (z > 0), then the lower
+    // one's, lower stratum count() + j being the point reflection of upper stratum j.
+    // Stratum of a unit local direction; -1 on the equator (z = 0) or for NaN.
+    int sphereStratumOf(const glm::vec3& local) const {
+        if (local.z > 0.f) return stratumOf(local);
+        if (!(local.z < 0.f)) return -1;
+        const int j = stratumOf(-local);
+        return j < 0 ? -1 : count() + j;
+    }
+    glm::vec3 sampleSphereStratum(int j, glm::vec2 u) const {
+        return j < count() ? sampleStratum(j, u) : -sampleStratum(j - count(), u);
+    }
+    glm::vec3 sphereCentre(int j) const { return j < count() ? centre(j) : -centre(j - count()); }
+
 private:
     int cols_, rows_;
     std::vector<glm::vec3> centres_;

@@ -269,10 +269,8 @@ std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
             return nullptr;
         }
         // The volume tables grow during rendering: they get the rest of the budget.
-        const double perVoxel = 2.0 * vp.cols * vp.rows *
-                                    (sizeof(double) + 2 * sizeof(float) + sizeof(uint64_t)) +
-                                64.0;
-        vp.volumeMaxVoxels = uint64_t(std::max(0.0, (maxMiB - mib) * 1024.0 * 1024.0 / perVoxel));
+        vp.volumeMaxVoxels = uint64_t(
+            std::max(0.0, (maxMiB - mib) * 1024.0 * 1024.0 / vdbMediumCellBytes(vp)));
         // OpenVDB reports trouble (e.g. an allocation) by exceptions: a message, not a crash.
         try {
             return std::make_unique<VdbField>(vp, scene);

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
-#include <unordered_set>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -78,6 +77,13 @@ double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
                              (s + 1) * sizeof(float) + sizeof(HemiFrame);
     // Per voxel: normals, offsets and about 8 bytes of OpenVDB tree (leaf values and masks).
     return voxels * (regionsPerVoxel * (perRegion + sizeof(int)) + 2 * sizeof(glm::vec3) + 12.0);
+}
+
+double vdbMediumCellBytes(const VdbParams& params) {
+    // Per stratum Q (double), float Q, visits and the CDF entry; per cell ~64 bytes more.
+    return 2.0 * params.cols * params.rows *
+               (sizeof(double) + 2 * sizeof(float) + sizeof(uint64_t)) +
+           64.0;
 }
 
 VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
@@ -216,7 +222,7 @@ void VdbField::buildFrames() {
     centreY_.resize(size_t(s));
     centreZ_.resize(size_t(s));
     for (int j = 0; j < s; ++j) {
-        glm::vec3 c = j < n ? layout_.centre(j) : -layout_.centre(j - n);
+        glm::vec3 c = layout_.sphereCentre(j);
         centreX_[size_t(j)] = c.x;
         centreY_[size_t(j)] = c.y;
         centreZ_[size_t(j)] = c.z;
@@ -363,11 +369,7 @@ int VdbField::stratumOf(int region, const glm::vec3& w) const {
     float len = glm::length(w);
     if (!(len > 0.f) || !std::isfinite(len)) return -1;
     const glm::vec3 local = frames_[size_t(region)].toLocal(w / len);
-    if (!params_.sphere) return layout_.stratumOf(local);
-    if (local.z > 0.f) return layout_.stratumOf(local);
-    if (!(local.z < 0.f)) return -1;  // the equator (measure zero) or NaN
-    int j = layout_.stratumOf(-local);
-    return j < 0 ? -1 : layout_.count() + j;
+    return params_.sphere ? layout_.sphereStratumOf(local) : layout_.stratumOf(local);
 }
 
 glm::vec3 VdbField::strataCentre(int region, int j) const {
@@ -393,7 +395,7 @@ glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOu
     const float* c = table_.cdf(size_t(region));
     const int n = layout_.count();
     const int j = sampleStrataCdf(c, table_.strata(), uStratum);
-    glm::vec3 local = j < n ? layout_.sampleStratum(j, u) : -layout_.sampleStratum(j - n, u);
+    glm::vec3 local = layout_.sampleSphereStratum(j, u);
     glm::vec3 w = glm::normalize(frames_[size_t(region)].toWorld(local));
     // Report exactly pdf(region, w) (rounding may move w across a stratum edge); on the
     // hemisphere's rim (pdf 0) keep the drawn stratum's density, as hemi does.
@@ -705,16 +707,13 @@ bool VdbField::load(const std::string& path, std::string* error) {
             const std::string cb = grid->metaValue<std::string>("rlpbrt:volume_cells");
             if (cb.size() % 12 != 0) return fail("corrupt medium cell table");
             const size_t cells = cb.size() / 12;
-            const glm::ivec3 dims = volume_->dims();
             fieldio::Reader r(cb);
-            std::unordered_set<uint64_t> seenCells;
             for (size_t i = 0; i < cells; ++i) {
                 const uint32_t x = r.u32(), y = r.u32(), z = r.u32();
-                if (x >= uint32_t(dims.x) || y >= uint32_t(dims.y) || z >= uint32_t(dims.z) ||
-                    !seenCells.insert(x + uint64_t(dims.x) * (y + uint64_t(dims.y) * z)).second)
-                    return fail("corrupt medium cell table");
-                vcoords.emplace_back(int(x), int(y), int(z));
+                vcoords.emplace_back(int(std::min(x, 1u << 30)), int(std::min(y, 1u << 30)),
+                                     int(std::min(z, 1u << 30)));
             }
+            if (!volume_->validCells(vcoords)) return fail("corrupt medium cell table");
             const size_t n = cells * size_t(volume_->strata());
             if (!fieldio::unpackDoubles(grid->metaValue<std::string>("rlpbrt:volume_q"), n, &vq) ||
                 !fieldio::unpackU64(grid->metaValue<std::string>("rlpbrt:volume_visits"), n,

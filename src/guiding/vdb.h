@@ -44,6 +44,9 @@ uint64_t vdbPointCount(const VdbParams& params, const SceneInfo& scene, double v
 // Upper estimate of a vdb field's bytes (every sample in its own voxel, capped by the
 // number of voxels a surface of the scene's area can cross).
 double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene);
+// Bytes of one medium cell (its full-sphere tables and CDF, grid share): max-mb's budget left
+// after the surface tables, divided by this, caps the medium cells.
+double vdbMediumCellBytes(const VdbParams& params);
 
 class VdbField final : public GuidingField {
 public:

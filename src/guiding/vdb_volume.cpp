@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <unordered_set>
 
 #include <openvdb/openvdb.h>
 
@@ -52,8 +53,7 @@ void VdbVolume::request(int slot, const glm::vec3& p) {
     if (slot < 0 || size_t(slot) >= requests_.size() || coords_.size() >= params_.maxVoxels ||
         !voxelOf(p, &ijk))
         return;
-    const uint64_t key =
-        uint64_t(ijk.x) + uint64_t(dims_.x) * (uint64_t(ijk.y) + uint64_t(dims_.y) * uint64_t(ijk.z));
+    const uint64_t key = voxelKey(ijk);
     Requests& r = requests_[size_t(slot)];
     if (r.seen.insert(key).second) r.order.push_back(key);
 }
@@ -61,11 +61,7 @@ void VdbVolume::request(int slot, const glm::vec3& p) {
 int VdbVolume::stratumOf(const glm::vec3& w) const {
     const float len = glm::length(w);
     if (!(len > 0.f) || !std::isfinite(len)) return -1;
-    const glm::vec3 d = w / len;
-    if (d.z > 0.f) return layout_.stratumOf(d);
-    if (!(d.z < 0.f)) return -1;
-    const int j = layout_.stratumOf(glm::vec3(d.x, d.y, -d.z));
-    return j < 0 ? -1 : layout_.count() + j;
+    return layout_.sphereStratumOf(w / len);
 }
 
 float VdbVolume::pdf(int cell, const glm::vec3& w) const {
@@ -84,9 +80,7 @@ glm::vec3 VdbVolume::sample(int cell, glm::vec2 u, float uStratum, float* pdfOut
     const float* c = table_.cdf(size_t(cell));
     const int n = layout_.count();
     const int j = sampleStrataCdf(c, table_.strata(), uStratum);
-    glm::vec3 w = j < n ? layout_.sampleStratum(j, u) : layout_.sampleStratum(j - n, u);
-    if (j >= n) w.z = -w.z;
-    w = glm::normalize(w);
+    const glm::vec3 w = glm::normalize(layout_.sampleSphereStratum(j, u));
     // Report exactly pdf(cell, w); on the equator (measure zero) keep the drawn stratum's.
     float p = pdf(cell, w);
     if (!(p > 0.f)) p = strataProbability(c, j) * float(double(n) / (2.0 * kPi));
@@ -104,12 +98,9 @@ float VdbVolume::scatteredEstimate(int cell,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (cell < 0 || cell >= cells()) return 0.f;
     const double* q = table_.q(size_t(cell));
-    const int n = layout_.count();
     double acc = 0.0;
-    for (int j = 0; j < 2 * n; ++j) {
-        glm::vec3 c = layout_.centre(j < n ? j : j - n);
-        if (j >= n) c.z = -c.z;
-        const float f = fcos(c);
+    for (int j = 0, n = table_.strata(); j < n; ++j) {
+        const float f = fcos(layout_.sphereCentre(j));
         if (f > 0.f && std::isfinite(f)) acc += q[j] * double(f);
     }
     return float(std::min(acc * layout_.stratumSolidAngle(), double(FLT_MAX)));
@@ -151,8 +142,7 @@ void VdbVolume::endPass() {
     for (Requests& r : requests_) {
         for (uint64_t key : r.order) {
             if (coords_.size() >= params_.maxVoxels) break;
-            const uint64_t dx = uint64_t(dims_.x), dy = uint64_t(dims_.y);
-            activate(glm::ivec3(int(key % dx), int((key / dx) % dy), int(key / (dx * dy))));
+            activate(voxelFromKey(key));
         }
         r.order.clear();
         r.seen.clear();
@@ -161,6 +151,15 @@ void VdbVolume::endPass() {
         confidence_.resize(coords_.size(), params_.warmup > 0.0 ? 0.f : 1.f);
         table_.grow(coords_.size(), params_.init, policy());
     }
+}
+
+bool VdbVolume::validCells(const std::vector<glm::ivec3>& coords) const {
+    std::unordered_set<uint64_t> seen;
+    for (const glm::ivec3& c : coords)
+        if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, dims_)) ||
+            !seen.insert(voxelKey(c)).second)
+            return false;
+    return true;
 }
 
 void VdbVolume::restore(const std::vector<glm::ivec3>& coords, std::vector<double> q,

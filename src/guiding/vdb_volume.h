@@ -75,6 +75,8 @@ public:
     const StrataTable& table() const { return table_; }
     // Integer coordinates of the voxel of each cell, in cell order (for saving).
     const std::vector<glm::ivec3>& cellCoords() const { return coords_; }
+    // True if every coordinate lies in [0, dims) and none repeats (the cells of a saved field).
+    bool validCells(const std::vector<glm::ivec3>& coords) const;
     // Replaces the cells and their learned data (coords.size() cells, q and visits of
     // cells * strata entries; the caller validated the sizes and values).
     void restore(const std::vector<glm::ivec3>& coords, std::vector<double> q,
@@ -87,6 +89,15 @@ public:
 private:
     struct Grid;  // the OpenVDB grid, defined in vdb_volume.cpp
     bool voxelOf(const glm::vec3& p, glm::ivec3* ijk) const;
+    // A voxel's linear index in the box (the request and duplicate-check key), and back.
+    uint64_t voxelKey(const glm::ivec3& ijk) const {
+        return uint64_t(ijk.x) +
+               uint64_t(dims_.x) * (uint64_t(ijk.y) + uint64_t(dims_.y) * uint64_t(ijk.z));
+    }
+    glm::ivec3 voxelFromKey(uint64_t key) const {
+        const uint64_t dx = uint64_t(dims_.x), dy = uint64_t(dims_.y);
+        return glm::ivec3(int(key % dx), int((key / dx) % dy), int(key / (dx * dy)));
+    }
     StrataTable::PolicyBuilder policy() const;
     void activate(const glm::ivec3& ijk);
 

@@ -212,9 +212,7 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
     return tr;
 }
 
-float PathIntegrator::mediumDirectionPdf(const Vec3& wo, float g, int region,
-                                         const Vec3& wi) const {
-    const float phase = henyeyGreenstein(glm::dot(wo, wi), g);
+float PathIntegrator::mediumDirectionPdf(float phase, int region, const Vec3& wi) const {
     const float mix = regionMix(region);
     return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * phase : phase;
 }
@@ -261,7 +259,7 @@ Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float 
     if (ls.isDelta) return phase * tr * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
     float w = powerHeuristic(1, lightPdf, 1,
-                             region >= 0 ? mediumDirectionPdf(wo, g, region, ls.wi) : phase);
+                             region >= 0 ? mediumDirectionPdf(phase, region, ls.wi) : phase);
     return phase * tr * ls.L * (w / lightPdf);
 }
 

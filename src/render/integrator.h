@@ -87,10 +87,11 @@ private:
                                const PathMedium& pm, Sampler& sampler, PathStats& stats) const;
     // The direction-sampling seam at a medium vertex: the phase function, or at a region the
     // guide with probability regionMix, mixed with it (f = the phase value; one 1D dimension
-    // more when a field is set). And the pdf of that strategy.
+    // more when a field is set). And the pdf of that strategy for wi, whose phase value is
+    // `phase`.
     DirectionSample sampleMediumDirection(const Vec3& wo, float g, int region,
                                           Sampler& sampler) const;
-    float mediumDirectionPdf(const Vec3& wo, float g, int region, const Vec3& wi) const;
+    float mediumDirectionPdf(float phase, int region, const Vec3& wi) const;
     // Transmittance of the segment o + t d, t in (0, tMax), starting in `medium`: through
     // medium boundaries (interface-only surfaces), zero at any other surface.
     Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,

@@ -55,18 +55,9 @@ inline float bitsToUnitFloat(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
 inline uint32_t sobolDim0(uint32_t i) { return reverseBits32(i); }
 
 // Second Sobol' dimension (primitive polynomial x + 1: its generator matrix is Pascal's
-// triangle mod 2) of index i, as a 0.32 fixed-point value. With sobolDim0 it forms a
-// (0,2)-sequence: every aligned block of 2^m indices is a (0,m,2)-net.
-inline uint32_t sobolDim1(uint32_t i) {
-    uint32_t v = 0;
-    for (uint32_t d = 0x80000000u; i != 0; i >>= 1, d ^= d >> 1)
-        if (i & 1u) v ^= d;
-    return v;
-}
-
-// sobolDim1 with its bits reversed, without a loop: bit j of the result is the XOR of the
-// index bits k whose positions are bitwise supersets of j (Lucas: C(k, j) is odd iff j is a
-// subset of k), the superset-sum transform over the 5 position bits.
+// triangle mod 2) of index i, bit-reversed: bit j of the result is the XOR of the index bits
+// k whose positions are bitwise supersets of j (Lucas: C(k, j) is odd iff j is a subset of
+// k), the superset-sum transform over the 5 position bits (no loop over the index bits).
 inline uint32_t sobolDim1Reversed(uint32_t i) {
     i ^= (i >> 1) & 0x55555555u;
     i ^= (i >> 2) & 0x33333333u;
@@ -75,6 +66,10 @@ inline uint32_t sobolDim1Reversed(uint32_t i) {
     i ^= (i >> 16) & 0x0000ffffu;
     return i;
 }
+
+// Second Sobol' dimension of index i as a 0.32 fixed-point value. With sobolDim0 it forms a
+// (0,2)-sequence: every aligned block of 2^m indices is a (0,m,2)-net.
+inline uint32_t sobolDim1(uint32_t i) { return reverseBits32(sobolDim1Reversed(i)); }
 
 // Bijection of 32-bit words in which output bit j depends only on input bits 0..j and the
 // seed (additions and x ^= x * even only carry upwards). Applied to bit-reversed values it is
