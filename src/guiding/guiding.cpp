@@ -17,6 +17,10 @@ GuidingField::~GuidingField() = default;
 
 float GuidingField::confidence(int region) const { return region >= 0 ? 1.f : 0.f; }
 
+float GuidingField::selection(int) const { return -1.f; }
+
+void GuidingField::recordSelection(int, int, const SelectionSample&) {}
+
 int GuidingField::lookupMedium(const glm::vec3&) const { return -1; }
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
@@ -126,8 +130,8 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
     } else if (key == "max-mb") {
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
         *maxMiB = d;
-    } else if (key == "mix" || key == "target") {
-        // Consumed by the integrator.
+    } else if (key == "mix" || key == "target" || key == "samples") {
+        // Consumed by the integrator and the render loop.
     } else {
         return 0;
     }

@@ -46,6 +46,22 @@ struct GuidingStats {
     uint64_t rejectedTargets = 0;   // NaN, Inf or negative targets dropped by record()
     uint64_t rejectedRecords = 0;   // bad slot/region or direction outside the hemisphere
     uint64_t activeVoxels = 0;      // vdb backend: active voxels of the grid (0 otherwise)
+    uint64_t selectionRegions = 0;  // regions with a learned selection (mix=learn)
+    double selectionMean = 0.0;     // their mean selection probability
+};
+
+// How the integrator drew a direction x at a region, for learning the region's selection
+// probability (GuidingField::selection, guiding/selection.h): it took the guide with
+// probability c * scale (c the selection in force, scale the region's confidence times the
+// BSDF's diffuse share), else the BSDF or phase function, whose pdfs at x are pGuide and
+// pOther; pdf = the mixture's pdf of x; integrand = the estimate of f cos Li at x that the
+// path delivered (its contribution after x times pdf; luminance).
+struct SelectionSample {
+    float integrand = 0.f;
+    float pdf = 0.f;
+    float pGuide = 0.f;
+    float pOther = 0.f;
+    float scale = 0.f;
 };
 
 // A learned directional distribution per spatial region. lookup/sample/pdf/scattered/
@@ -95,6 +111,14 @@ public:
     // data sample mostly the BSDF. Frozen between passes like the policy. Default: 1.
     virtual float confidence(int region) const;
 
+    // The learned probability of choosing the guide over the BSDF (or phase function) at a
+    // region, frozen per pass like the policy, or -1 where none has been learned (the
+    // integrator then uses its mix setting). Default: -1.
+    virtual float selection(int region) const;
+    // Records how a direction was drawn at `region` and what it brought (SelectionSample),
+    // for learning selection(); thread-safe across slots like record(). Default: ignored.
+    virtual void recordSelection(int slot, int region, const SelectionSample& s);
+
     // Learning: during a pass, record that from `region` the direction w received target T
     // (T = Le + scatteredEstimate at the next vertex, or the environment radiance). `slot` is
     // the caller's work-item index (film tile) in [0, numSlots): records are merged in slot
@@ -141,7 +165,11 @@ public:
 //                0 = always full weight, the paper's behaviour)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
-//   mix, target  consumed by the integrator; accepted and ignored here
+//   mix, target, samples
+//                consumed by the integrator and the render loop; accepted and ignored here
+//                ("samples=independent": a sample set per pass; "mix=learn" makes
+//                the integrator record selection samples, from which every backend learns
+//                selection() per region)
 // Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.
 // Parameters alpha, strata, init, epsilon, cosine, max-mb, mix, target as hemi, and
 //   voxel        N: N voxels along the longest axis of the scene bounds, 1..4096

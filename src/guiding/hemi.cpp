@@ -167,6 +167,14 @@ float HemiField::confidence(int region) const {
     return validRegion(region) ? frames_[size_t(region)].confidence : 0.f;
 }
 
+float HemiField::selection(int region) const {
+    return validRegion(region) ? table_.selection().selection(size_t(region)) : -1.f;
+}
+
+void HemiField::recordSelection(int slot, int region, const SelectionSample& s) {
+    if (validRegion(region)) table_.selection().record(slot, region, s);
+}
+
 float HemiField::radiance(int region, const glm::vec3& w) const {
     int j = stratumOf(region, w);
     if (j < 0) return 0.f;
@@ -238,7 +246,14 @@ std::string HemiField::describe() const {
                   (unsigned long long)stats().passes, (unsigned long long)stats().records,
                   (unsigned long long)stats().rejectedTargets,
                   (unsigned long long)stats().rejectedRecords);
-    return buf;
+    std::string line = buf;
+    const SelectionLearner& sel = table_.selection();
+    if (sel.learnedRegions() > 0) {
+        std::snprintf(buf, sizeof(buf), "; learned selection in %zu regions, mean %.3f",
+                      sel.learnedRegions(), sel.meanSelection());
+        line += buf;
+    }
+    return line;
 }
 
 GuidingStats HemiField::stats() const { return table_.stats(); }

@@ -25,12 +25,14 @@ void StrataTable::reset(size_t regions, int strata, double init, const PolicyBui
     }
     slots_.clear();
     stats_ = GuidingStats();
+    selection_.reset(regions);
 }
 
 void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy) {
     if (regions <= regions_ || strata_ <= 0) return;
     const size_t n = size_t(strata_), old = regions_;
     regions_ = regions;
+    selection_.grow(regions);
     q_.resize(regions * n, init);
     qf_.resize(regions * n, float(std::min(init, double(FLT_MAX))));
     visits_.resize(regions * n, 0);
@@ -55,6 +57,7 @@ void StrataTable::beginPass(int numSlots) {
         s.records.clear();  // keeps the capacity of earlier passes
         s.rejectedTargets = s.rejectedRecords = 0;
     }
+    selection_.beginPass(numSlots);
 }
 
 void StrataTable::mirror(size_t region) {
@@ -104,6 +107,9 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
     }
     ++stats_.passes;
     stats_.records += total;
+    selection_.endPass();
+    stats_.selectionRegions = selection_.learnedRegions();
+    stats_.selectionMean = selection_.meanSelection();
     if (total > 0 && regions_ > 0) {
         // Stable counting sort by region: within a region, records stay in slot order.
         regionStart_.assign(regions_ + 1, 0);
@@ -136,13 +142,14 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
 
 size_t StrataTable::bytes() const {
     return q_.capacity() * sizeof(double) + qf_.capacity() * sizeof(float) +
-           visits_.capacity() * sizeof(uint64_t) + cdf_.capacity() * sizeof(float);
+           visits_.capacity() * sizeof(uint64_t) + cdf_.capacity() * sizeof(float) +
+           selection_.bytes();
 }
 
 size_t StrataTable::scratchBytes() const {
     size_t b = merged_.capacity() * sizeof(Record) + regionStart_.capacity() * sizeof(uint64_t);
     for (const SlotBuffer& s : slots_) b += s.records.capacity() * sizeof(Record);
-    return b;
+    return b + selection_.scratchBytes();
 }
 
 }  // namespace rlpbrt::guiding

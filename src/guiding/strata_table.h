@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "guiding/guiding.h"
+#include "guiding/selection.h"
 
 namespace rlpbrt::guiding {
 
@@ -76,6 +77,10 @@ public:
     void assign(std::vector<double> q, std::vector<uint64_t> visits,
                 const PolicyBuilder& policy);
 
+    // The regions' learned selection probabilities (same regions, same passes).
+    SelectionLearner& selection() { return selection_; }
+    const SelectionLearner& selection() const { return selection_; }
+
     const std::vector<double>& qTable() const { return q_; }
     const std::vector<uint64_t>& visitTable() const { return visits_; }
     const std::vector<float>& cdfTable() const { return cdf_; }
@@ -112,6 +117,7 @@ private:
     std::vector<uint64_t> regionStart_;
     std::vector<Record> merged_;
     GuidingStats stats_;
+    SelectionLearner selection_;
 };
 
 }  // namespace rlpbrt::guiding

@@ -442,6 +442,17 @@ float VdbField::radiance(int region, const glm::vec3& w) const {
     return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
 }
 
+float VdbField::selection(int region) const {
+    if (const int cell = volumeCell(region); cell >= 0) return volume_->selection().selection(size_t(cell));
+    return validRegion(region) ? table_.selection().selection(size_t(region)) : -1.f;
+}
+
+void VdbField::recordSelection(int slot, int region, const SelectionSample& s) {
+    if (const int cell = volumeCell(region); cell >= 0)
+        return volume_->selection().record(slot, cell, s);
+    if (validRegion(region)) table_.selection().record(slot, region, s);
+}
+
 void VdbField::beginPass(int numSlots) {
     table_.beginPass(numSlots);
     if (volume_) volume_->beginPass(numSlots);

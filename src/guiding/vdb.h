@@ -65,6 +65,8 @@ public:
     float irradianceEstimate(int region, const glm::vec3& n) const override;
     float radiance(int region, const glm::vec3& w) const override;
     float confidence(int region) const override;
+    float selection(int region) const override;
+    void recordSelection(int slot, int region, const SelectionSample& s) override;
     void beginPass(int numSlots) override;
     void record(int slot, int region, const glm::vec3& w, float target) override;
     void endPass() override;

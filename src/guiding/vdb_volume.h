@@ -73,6 +73,9 @@ public:
     glm::ivec3 dims() const { return dims_; }
     const VolumeParams& params() const { return params_; }
     const StrataTable& table() const { return table_; }
+    // The cells' learned selection probabilities (GuidingField::selection).
+    SelectionLearner& selection() { return table_.selection(); }
+    const SelectionLearner& selection() const { return table_.selection(); }
     // Integer coordinates of the voxel of each cell, in cell order (for saving).
     const std::vector<glm::ivec3>& cellCoords() const { return coords_; }
     // True if every coordinate lies in [0, dims) and none repeats (the cells of a saved field).

@@ -45,11 +45,13 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     *settings = GuideSettings();
     field->reset();
     auto it = config.params.find("mix");
-    if (it != config.params.end()) {
+    if (it != config.params.end() && it->second == "learn") {
+        settings->learnMix = true;
+    } else if (it != config.params.end()) {
         char* end = nullptr;
         float mix = std::strtof(it->second.c_str(), &end);
         if (end == it->second.c_str() || *end != '\0' || !(mix >= 0.f && mix <= 1.f)) {
-            *error = "mix must be a number in [0, 1], got \"" + it->second + "\"";
+            *error = "mix must be a number in [0, 1] or \"learn\", got \"" + it->second + "\"";
             return false;
         }
         settings->mix = mix;
@@ -61,6 +63,15 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
             return false;
         }
         settings->sampledTarget = target->second == "sample";
+    }
+    auto samples = config.params.find("samples");
+    if (samples != config.params.end()) {
+        if (samples->second != "sequence" && samples->second != "independent") {
+            *error = "samples must be \"sequence\" or \"independent\", got \"" +
+                     samples->second + "\"";
+            return false;
+        }
+        settings->independentPasses = samples->second == "independent";
     }
     if (config.backend == "none") return true;
     guiding::SceneInfo info;
@@ -106,6 +117,17 @@ bool guidable(const BSDF& bsdf) {
 
 // The pending training record of the last guided vertex: its region and direction, and the
 // target collected so far through delta vertices (weight = product of their f cos / pdf).
+// A guided vertex of the path whose direction sample feeds the selection learning (mix=learn):
+// the radiance the path gathers after it, over the throughput at it, is the sample's
+// contribution F = f cos Li / pdf, so its integrand is F * pdf (known when the path ends).
+struct SelectionVertex {
+    int region;
+    guiding::SelectionSample s;
+    float lumL;     // luminance of L when the direction was sampled
+    float lumBeta;  // luminance of the throughput at the vertex
+};
+constexpr int kMaxSelectionVertices = 16;
+
 struct PendingRecord {
     int region = -1;
     Vec3 w{0.f};
@@ -141,7 +163,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
-    const float mix = regionMix(region) * share;
+    ds.scale = guide_.field->confidence(region) * share;
+    const float mix = regionSelection(region) * ds.scale;
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
@@ -159,6 +182,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         pGuide = guide_.field->pdf(region, ds.wi);
     }
     ds.pdf = mix * pGuide + (1.f - mix) * pBsdf;
+    ds.pGuide = pGuide;
+    ds.pOther = pBsdf;
     ds.transmission = glm::dot(ds.wi, si.ng) * glm::dot(si.wo, si.ng) < 0.f;
     if (!(ds.pdf > 0.f) || !std::isfinite(ds.pdf)) return DirectionSample();
     return ds;
@@ -223,7 +248,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3
     DirectionSample ds;
     const float uc = guide_.field ? sampler.get1D() : 1.f;
     const Vec2 u = sampler.get2D();
-    const float mix = regionMix(region);
+    ds.scale = region >= 0 ? guide_.field->confidence(region) : 0.f;
+    const float mix = region >= 0 ? regionSelection(region) * ds.scale : 0.f;
     float pGuide = 0.f, pPhase = 0.f;
     if (uc < mix) {
         ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide);
@@ -236,6 +262,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3
     }
     ds.f = Spectrum(pPhase);
     ds.pdf = mix * pGuide + (1.f - mix) * pPhase;
+    ds.pGuide = pGuide;
+    ds.pOther = pPhase;
     if (!(ds.pdf > 0.f) || !std::isfinite(ds.pdf)) return DirectionSample();
     return ds;
 }
@@ -298,6 +326,15 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     guiding::GuidingField* field = guide_.field;
     const bool learn = field && guide_.learn;
     PendingRecord pending;
+    SelectionVertex selVerts[kMaxSelectionVertices];
+    int numSelVerts = 0;
+    const bool learnSelection = learn && guide_.learnMix;
+    auto pushSelection = [&](int region, const DirectionSample& ds) {
+        if (!learnSelection || region < 0 || numSelVerts >= kMaxSelectionVertices) return;
+        selVerts[numSelVerts++] = SelectionVertex{
+            region, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
+            luminance(L), luminance(beta)};
+    };
     // Media (volpath): the medium the ray travels in; tracking decisions use a per-path
     // generator seeded from two sampler dimensions. Scenes without media skip all of it.
     const bool media = scene_.hasMedia();
@@ -359,6 +396,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                     }
                 }
                 if (!(ds.pdf > 0.f)) break;
+                pushSelection(sampleRegion, ds);
                 const Vec3 wi = ds.wi;
                 beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
                 dirPdf = ds.pdf;
@@ -467,6 +505,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             flush(emitted + (std::isfinite(est) ? est : 0.f));
         }
         if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
+        pushSelection(sampleRegion, ds);
         Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
         beta *= weight;
         dirPdf = ds.pdf;
@@ -476,6 +515,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 pending = PendingRecord();
                 pending.region = region;
                 pending.w = ds.wi;
+
             } else if (pending.active() && region < 0 && !canGuide) {
                 pending.weight *= luminance(weight);  // through a delta vertex
             } else {
@@ -498,6 +538,14 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             float q = std::max(0.05f, 1.f - maxComponent(rrBeta));
             if (sampler.get1D() < q) break;
             beta /= 1.f - q;
+        }
+    }
+    if (numSelVerts > 0) {
+        const float lumL = luminance(L);
+        for (int i = 0; i < numSelVerts; ++i) {
+            SelectionVertex& v = selVerts[i];
+            v.s.integrand = (lumL - v.lumL) / v.lumBeta * v.s.pdf;
+            field->recordSelection(slot, v.region, v.s);
         }
     }
     return L;

@@ -35,12 +35,26 @@ struct GuideSettings {
     // Probability of sampling a direction from the guide at a vertex that has guiding data
     // (one-sample MIS mixture with BSDF sampling): 0 = BSDF only, 1 = the paper's pure policy.
     float mix = 0.5f;
+    // mix=learn: the probability is learned per region (GuidingField::selection, from the
+    // selection samples the integrator records); `mix` stays the value for regions without a
+    // learned one.
+    bool learnMix = false;
     bool learn = true;  // record Eq. 1 targets during rendering
     // How the sum of Eq. 1 is evaluated at a non-Lambertian vertex y: over all strata
     // (n BSDF evaluations, the paper's form) or with the one direction sampled at y
     // (Q(y, w') f cos / pdf: an unbiased one-sample estimate of the same sum, no extra
     // evaluations). Lambertian vertices always use the exact sum (learned irradiance).
     bool sampledTarget = true;
+    // Where a guided render's passes take their samples (samples=sequence|independent):
+    // from the one low-discrepancy sequence per pixel that plain rendering uses (false, the
+    // default), or from an independently randomized set per pass (true). The sequence
+    // keeps the stratification across passes: at 64 spp, hemi relMSE metal-spheres 0.00392
+    // -> 0.00266 (none: 0.00264), buddha-fractal 0.0226 -> 0.0179, veach-bidir 0.181 ->
+    // 0.168. Its price is a correlation between the policy (learned from earlier passes)
+    // and the samples that follow them in the same pixel: a bias that vanishes as the
+    // policy converges, +0.044% / +0.029% / +0.008% at 16 / 64 / 256 spp on a white
+    // furnace (docs/STABILITY.md). Independent sets are exactly unbiased.
+    bool independentPasses = false;
 };
 
 class Rng;
@@ -60,6 +74,9 @@ private:
         float pdf = 0.f;       // of the whole strategy (mixture pdf when guided)
         bool specular = false;
         bool transmission = false;
+        // Guided strategies only: the guide's and the BSDF's (phase function's) pdfs of wi, and
+        // the factor of the region's selection in the guide probability (confidence x share).
+        float pGuide = 0.f, pOther = 0.f, scale = 0.f;
     };
     // `share`: the BSDF's diffuse share; the probability of a guided sample is
     // regionMix(region) * share (region < 0: BSDF only). The region's confidence is read
@@ -71,7 +88,16 @@ private:
     // Probability of a guided sample at a region: the mix setting times the region's
     // confidence (0 without a region).
     float regionMix(int region) const {
-        return region >= 0 ? guide_.mix * guide_.field->confidence(region) : 0.f;
+        return region >= 0 ? regionSelection(region) * guide_.field->confidence(region) : 0.f;
+    }
+    // The selection probability of a region: learned (mix=learn, where the field has one) or
+    // the mix setting.
+    float regionSelection(int region) const {
+        if (guide_.learnMix) {
+            const float s = guide_.field->selection(region);
+            if (s >= 0.f) return s;
+        }
+        return guide_.mix;
     }
     // Media (scene_.hasMedia() only): the medium a path is in and its tracking generator.
     struct PathMedium {

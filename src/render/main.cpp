@@ -285,6 +285,10 @@ int main(int argc, char** argv) {
             j["guide_mix"] = mix;
             if (guide == "vdb") j["guide_active_voxels"] = gs.activeVoxels;
             if (gs.mediumCells) j["guide_medium_cells"] = gs.mediumCells;
+            if (gs.selectionRegions) {
+                j["guide_selection_regions"] = gs.selectionRegions;
+                j["guide_selection_mean"] = gs.selectionMean;
+            }
         }
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;

@@ -52,12 +52,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     const int totalSpp = scene.sampler->samplesPerPixel();
     const bool timed = options.timeBudget > 0.0;
     // Passes: plain path tracing takes one sample per pixel per pass from one sequence per
-    // pixel. A guided render learns between passes, so each pass draws an independent sample
-    // set (Sampler::passSampler) sized half the samples so far (1, 1, 1, 1, 2, 3, 4, 6, 9,
-    // ...; at most 64): frequent updates early, well-stratified sets later. Measured at 64 spp
-    // (relMSE, hemi): doubling pass sizes gave veach-bidir 0.382 / breakfast 4.73 against
-    // 0.345 / 4.46 with halves; one final set for the last three quarters of the budget,
-    // without learning, gave buddha-fractal 0.0222 against 0.0215.
+    // pixel. A guided render learns between passes, with passes sized half the samples so far
+    // (1, 1, 1, 1, 2, 3, 4, 6, 9, ...; at most 64): frequent updates early. Its samples
+    // continue the same sequence per pixel, or (samples=independent, GuideSettings::
+    // independentPasses) come from a set of the pass's own (Sampler::passSampler).
+    // Measured at 64 spp (relMSE, hemi): doubling pass sizes gave veach-bidir 0.382 /
+    // breakfast 4.73 against 0.345 / 4.46 with halves (independent sets).
     const bool guided = field != nullptr;
     constexpr int kMaxGuidedPass = 64;
 
@@ -83,11 +83,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
         }
         if (count <= 0) break;
-        // Guided: this pass's own sample set, indices from 0; otherwise the next samples of
-        // the one sequence per pixel.
-        const int first = guided ? 0 : result.spp;
+        // An independent pass: its own sample set, indices from 0; otherwise the next samples
+        // of the one sequence per pixel.
+        const bool ownSet = guided && options.guide.independentPasses;
+        const int first = ownSet ? 0 : result.spp;
         std::unique_ptr<Sampler> passProto =
-            guided ? scene.sampler->passSampler(count, pass) : nullptr;
+            ownSet ? scene.sampler->passSampler(count, pass) : nullptr;
         if (field) field->beginPass(int(tiles.size()));
         arena.execute([&] {
             tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {

@@ -1,0 +1,116 @@
+#include "guiding/selection.h"
+
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace rlpbrt::guiding {
+
+void SelectionLearner::reset(size_t regions) {
+    regions_ = regions;
+    sums_.clear();
+    weights_.clear();
+    selection_.clear();
+    slots_.clear();
+}
+
+void SelectionLearner::grow(size_t regions) {
+    if (regions <= regions_) return;
+    regions_ = regions;
+    if (selection_.empty()) return;  // nothing learned yet: allocated on the first samples
+    sums_.resize(regions * kCandidates, 0.0);
+    weights_.resize(regions, 0.0);
+    selection_.resize(regions, -1.f);
+}
+
+void SelectionLearner::beginPass(int numSlots) {
+    const size_t n = size_t(numSlots > 0 ? numSlots : 0);
+    if (slots_.size() != n) slots_.resize(n);
+    for (SlotBuffer& s : slots_) s.samples.clear();
+}
+
+void SelectionLearner::record(int slot, int region, const SelectionSample& s) {
+    if (slot < 0 || size_t(slot) >= slots_.size() || region < 0 || size_t(region) >= regions_)
+        return;
+    const double pi = double(s.integrand);
+    const double a = pi * pi / double(s.pdf);
+    const float b = s.pOther, d = s.scale * (s.pGuide - s.pOther);
+    if (!(pi > 0.0) || !(a > 0.0) || !std::isfinite(a) || !(b >= 0.f) || !std::isfinite(d))
+        return;
+    slots_[size_t(slot)].samples.push_back(
+        Sample{uint32_t(region), float(std::min(a, double(std::numeric_limits<float>::max()))),
+               b, d});
+}
+
+void SelectionLearner::endPass() {
+    size_t total = 0;
+    for (const SlotBuffer& s : slots_) total += s.samples.size();
+    if (selection_.empty()) {
+        if (total == 0) return;  // memory only once the integrator learns selections
+        sums_.assign(regions_ * kCandidates, 0.0);
+        weights_.assign(regions_, 0.0);
+        selection_.assign(regions_, -1.f);
+    }
+    const size_t regions = regions_;
+    // Stable counting sort by region: within a region, samples stay in slot order.
+    start_.assign(regions + 1, 0);
+    for (const SlotBuffer& s : slots_)
+        for (const Sample& x : s.samples) ++start_[x.region + 1];
+    for (size_t r = 0; r < regions; ++r) start_[r + 1] += start_[r];
+    merged_.resize(total);
+    for (const SlotBuffer& s : slots_)
+        for (const Sample& x : s.samples) merged_[start_[x.region]++] = x;
+    // start_[r] now holds the end of region r. Every region decays, sampled or not.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 256),
+                      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t r = range.begin(); r != range.end(); ++r) {
+            double* sums = &sums_[r * kCandidates];
+            double add[kCandidates] = {};
+            const size_t b = r == 0 ? 0 : start_[r - 1], e = start_[r];
+            for (size_t i = b; i < e; ++i) {
+                const Sample& x = merged_[i];
+                for (int k = 0; k < kCandidates; ++k) {
+                    const double p = double(x.b) + double(candidate(k)) * double(x.d);
+                    add[k] += p > 0.0 ? double(x.a) / p : std::numeric_limits<double>::infinity();
+                }
+            }
+            for (int k = 0; k < kCandidates; ++k) sums[k] = kDecay * sums[k] + add[k];
+            weights_[r] = kDecay * weights_[r] + double(e - b);
+            if (weights_[r] < kMinSamples) continue;
+            int best = -1;
+            for (int k = 0; k < kCandidates; ++k)
+                if (std::isfinite(sums[k]) && (best < 0 || sums[k] < sums[best])) best = k;
+            selection_[r] = best < 0 ? -1.f : candidate(best);
+        }
+    });
+    for (SlotBuffer& s : slots_) s.samples.clear();
+}
+
+size_t SelectionLearner::learnedRegions() const {
+    size_t n = 0;
+    for (float s : selection_) n += s >= 0.f;
+    return n;
+}
+
+double SelectionLearner::meanSelection() const {
+    double sum = 0.0;
+    size_t n = 0;
+    for (float s : selection_)
+        if (s >= 0.f) sum += s, ++n;
+    return n > 0 ? sum / double(n) : 0.0;
+}
+
+size_t SelectionLearner::bytes() const {
+    return sums_.capacity() * sizeof(double) + weights_.capacity() * sizeof(double) +
+           selection_.capacity() * sizeof(float);
+}
+
+size_t SelectionLearner::scratchBytes() const {
+    size_t b = merged_.capacity() * sizeof(Sample) + start_.capacity() * sizeof(uint64_t);
+    for (const SlotBuffer& s : slots_) b += s.samples.capacity() * sizeof(Sample);
+    return b;
+}
+
+}  // namespace rlpbrt::guiding
