@@ -359,6 +359,8 @@ const Extreme kExtremes[] = {
     {"normal_angle_tiny", {{"normal-angle", "0.001"}}},
     {"target_sample", {{"target", "sample"}}},
     {"knn_1", {{"knn", "1"}}},
+    {"mix_learn", {{"mix", "learn"}, {"warmup", "0"}}},
+    {"samples_independent", {{"samples", "independent"}}},
 };
 
 INSTANTIATE_TEST_SUITE_P(Hemi, GuideExtremes, ::testing::ValuesIn(kExtremes),
@@ -379,7 +381,7 @@ TEST_P(VdbMediumExtremes, LosslessMediumStaysExact) {
     expectMean(renderText(foggyEnclosure(0.5, 0.8, 1.0), "vdb", e.params), 1.0,
                std::string(e.name) + " thin, g 0.8");
     auto mix = e.params.find("mix");
-    if (mix == e.params.end() || std::stod(mix->second) < 1.0)
+    if (mix == e.params.end() || mix->second == "learn" || std::stod(mix->second) < 1.0)
         expectMean(renderText(foggyEnclosure(4.0, 0.8, 1.0), "vdb", e.params), 1.0,
                    std::string(e.name) + " thick, g 0.8");
 }
@@ -390,6 +392,7 @@ const Extreme kMediumExtremes[] = {
     {"volume_voxel_1", {{"volume-voxel", "1"}, {"mix", "1"}, {"warmup", "0"}}},
     {"volume_voxel_256", {{"volume-voxel", "256"}, {"warmup", "0"}}},
     {"mix_0_9_warmup_0", {{"mix", "0.9"}, {"warmup", "0"}}},
+    {"mix_learn", {{"mix", "learn"}, {"warmup", "0"}}},
     {"alpha_1", {{"alpha", "1"}, {"mix", "1"}, {"warmup", "0"}}},
 };
 

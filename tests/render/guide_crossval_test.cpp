@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <vector>
 
 #include "guiding/guiding.h"
 #include "parser/diagnostics.h"
@@ -94,6 +95,43 @@ TEST(GuideCrossValidation, NoneHemiVdbAgreeOnCornellBox) {
     expectSameMean(hemi.image, none.image, "hemi - none");
     expectSameMean(vdb.image, none.image, "vdb - none");
     expectSameMean(hemi.image, vdb.image, "hemi - vdb");
+}
+
+// The integrator's own --guide-param keys: mix (a number or "learn"), target, samples.
+TEST(GuideCrossValidation, IntegratorParametersAreValidated) {
+    RLPBRT_REQUIRE_SHARED();
+    Diagnostics diag;
+    diag.setStream(nullptr);
+    SceneDesc desc;
+    ASSERT_TRUE(loadSceneDesc(test::sharedDir() + "/scenes/cornell-box/scene.small.pbrt", diag,
+                              &desc));
+    std::unique_ptr<Scene> scene = buildScene(desc, BuildOptions(), diag);
+    ASSERT_NE(scene, nullptr);
+    auto setup = [&](const std::map<std::string, std::string>& params, GuideSettings* gs,
+                     std::string* err) {
+        guiding::GuideConfig gc;
+        gc.backend = "hemi";
+        gc.params = params;
+        std::unique_ptr<guiding::GuidingField> field;
+        return setupGuiding(*scene, gc, &field, gs, err);
+    };
+    GuideSettings gs;
+    std::string err;
+    ASSERT_TRUE(setup({{"mix", "learn"}, {"samples", "independent"}}, &gs, &err)) << err;
+    EXPECT_TRUE(gs.learnMix);
+    EXPECT_TRUE(gs.independentPasses);
+    EXPECT_FLOAT_EQ(gs.mix, 0.5f);  // the value where no selection is learned yet
+    ASSERT_TRUE(setup({{"mix", "0.25"}, {"samples", "sequence"}}, &gs, &err)) << err;
+    EXPECT_FALSE(gs.learnMix);
+    EXPECT_FALSE(gs.independentPasses);
+    EXPECT_FLOAT_EQ(gs.mix, 0.25f);
+    for (const auto& bad : std::vector<std::map<std::string, std::string>>{
+             {{"mix", "learnt"}}, {{"mix", "1.5"}}, {{"samples", "random"}},
+             {{"target", "all"}}}) {
+        err.clear();
+        EXPECT_FALSE(setup(bad, &gs, &err)) << bad.begin()->first;
+        EXPECT_NE(err.find(bad.begin()->first), std::string::npos) << err;
+    }
 }
 
 // A guided render's passes continue the one sequence per pixel of a plain render (the default,
