@@ -37,6 +37,16 @@ struct HemiFrame {
     glm::vec3 toWorld(const glm::vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };
 
+// w scaled to unit length, for the strata lookups: false for a zero, NaN or infinite w. A w
+// that is unit to within 1e-5 in squared length (every direction the integrator passes) is
+// returned as it is: no square root or division on the per-vertex path.
+inline bool unitDirection(const glm::vec3& w, glm::vec3* unit) {
+    const float len2 = glm::dot(w, w);
+    if (!(len2 > 0.f) || !std::isfinite(len2)) return false;
+    *unit = std::abs(len2 - 1.f) <= 1e-5f ? w : w / std::sqrt(len2);
+    return true;
+}
+
 // Azimuth of (x, y) in [0, 2 pi] (0 for (0, 0), NaN for NaN input), to within 4e-8 rad of
 // the exact value: an odd minimax polynomial of degree 15 for atan on [0, 1] after octant
 // reduction. That is below a float ulp of phi, so strata boundaries agree with the exact
@@ -83,7 +93,17 @@ public:
         int row = static_cast<int>(local.z * static_cast<float>(rows_));
         row = row < rows_ - 1 ? row : rows_ - 1;
         int col = 0;
-        if (cols_ > 1) {
+        if (octantShift_ >= 0) {
+            // cols_ divides 8: the column from the octant of (x, y), by comparisons only.
+            const float x = local.x, y = local.y;
+            if (!(x == x) || !(y == y)) return -1;  // NaN components
+            int octant;
+            if (y >= 0.f)
+                octant = x >= 0.f ? (y < x || y == 0.f ? 0 : 1) : (-x < y ? 2 : 3);
+            else
+                octant = x < 0.f ? (-x > -y ? 4 : 5) : (x < -y ? 6 : 7);
+            col = octant >> octantShift_;
+        } else if (cols_ > 1) {
             float phi = azimuth(local.x, local.y);
             if (!(phi >= 0.f)) return -1;  // NaN components
             col = static_cast<int>(phi * (static_cast<float>(cols_) / kTwoPiF));
@@ -122,6 +142,7 @@ public:
 
 private:
     int cols_, rows_;
+    int octantShift_ = -1;  // column = octant >> this for 2, 4, 8 columns (2, 1, 0); else -1
     std::vector<glm::vec3> centres_;
 };
 

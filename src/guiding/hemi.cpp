@@ -112,10 +112,9 @@ int HemiField::prefetched(int region) const {
 }
 
 int HemiField::stratumOf(int region, const glm::vec3& w) const {
-    if (!validRegion(region)) return -1;
-    float len = glm::length(w);
-    if (!(len > 0.f) || !std::isfinite(len)) return -1;
-    return layout_.stratumOf(frames_[size_t(region)].frame.toLocal(w / len));
+    glm::vec3 unit;
+    if (!validRegion(region) || !unitDirection(w, &unit)) return -1;
+    return layout_.stratumOf(frames_[size_t(region)].frame.toLocal(unit));
 }
 
 float HemiField::pdf(int region, const glm::vec3& w) const {

@@ -365,10 +365,9 @@ int VdbField::lookupWith(const glm::vec3& p, const glm::vec3& n, Probe& probe) c
 }
 
 int VdbField::stratumOf(int region, const glm::vec3& w) const {
-    if (!validRegion(region)) return -1;
-    float len = glm::length(w);
-    if (!(len > 0.f) || !std::isfinite(len)) return -1;
-    const glm::vec3 local = frames_[size_t(region)].toLocal(w / len);
+    glm::vec3 unit;
+    if (!validRegion(region) || !unitDirection(w, &unit)) return -1;
+    const glm::vec3 local = frames_[size_t(region)].toLocal(unit);
     return params_.sphere ? layout_.sphereStratumOf(local) : layout_.stratumOf(local);
 }
 

@@ -59,9 +59,8 @@ void VdbVolume::request(int slot, const glm::vec3& p) {
 }
 
 int VdbVolume::stratumOf(const glm::vec3& w) const {
-    const float len = glm::length(w);
-    if (!(len > 0.f) || !std::isfinite(len)) return -1;
-    return layout_.sphereStratumOf(w / len);
+    glm::vec3 unit;
+    return unitDirection(w, &unit) ? layout_.sphereStratumOf(unit) : -1;
 }
 
 float VdbVolume::pdf(int cell, const glm::vec3& w) const {
