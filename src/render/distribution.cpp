@@ -29,10 +29,19 @@ Distribution1D::Distribution1D(const float* f, int n) {
 }
 
 int Distribution1D::findInterval(float u) const {
-    // Largest i with cdf_[i] <= u, clamped to a valid piece.
-    auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-    int i = static_cast<int>(it - cdf_.begin()) - 1;
-    return clamp(i, 0, count() - 1);
+    // Largest i with cdf_[i] <= u (cdf_[0] = 0), clamped to a valid piece: a branchless
+    // binary search that loads both possible next probes ahead, since the CDFs of large
+    // environment maps miss the caches.
+    const float* b = cdf_.data();
+    size_t len = cdf_.size();
+    while (len > 1) {
+        const size_t half = len / 2;
+        __builtin_prefetch(b + half / 2);
+        __builtin_prefetch(b + half + half / 2);
+        b = b[half] <= u ? b + half : b;
+        len -= half;
+    }
+    return clamp(static_cast<int>(b - cdf_.data()), 0, count() - 1);
 }
 
 float Distribution1D::sampleContinuous(float u, float* pdf, int* offset) const {
