@@ -21,7 +21,8 @@ double hemiEstimatedBytes(const HemiParams& p) {
     const double n = double(p.cols) * double(p.rows);
     const double perRegion =
         n * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) + (n + 1) * sizeof(float) +
-        64.0;  // RegionFrame
+        64.0 +  // RegionFrame
+        SelectionLearner::kBytesPerRegion;
     // Per point: position, normal, the tree's copy, its index entry and a share of the nodes.
     const double perPoint = 3 * sizeof(glm::vec3) + sizeof(uint32_t) + 8.0;
     return double(p.points) * (2.0 * perRegion + perPoint);

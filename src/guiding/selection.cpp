@@ -6,6 +6,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "guiding/slot_merge.h"
+
 namespace rlpbrt::guiding {
 
 void SelectionLearner::reset(size_t regions) {
@@ -54,14 +56,9 @@ void SelectionLearner::endPass() {
         selection_.assign(regions_, -1.f);
     }
     const size_t regions = regions_;
-    // Stable counting sort by region: within a region, samples stay in slot order.
-    start_.assign(regions + 1, 0);
-    for (const SlotBuffer& s : slots_)
-        for (const Sample& x : s.samples) ++start_[x.region + 1];
-    for (size_t r = 0; r < regions; ++r) start_[r + 1] += start_[r];
-    merged_.resize(total);
-    for (const SlotBuffer& s : slots_)
-        for (const Sample& x : s.samples) merged_[start_[x.region]++] = x;
+    mergeByRegion<Sample>(
+        slots_, [](const SlotBuffer& s) -> const std::vector<Sample>& { return s.samples; },
+        regions, &start_, &merged_);
     // start_[r] now holds the end of region r. Every region decays, sampled or not.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 256),
                       [&](const tbb::blocked_range<size_t>& range) {

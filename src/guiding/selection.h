@@ -28,6 +28,10 @@ public:
     static constexpr double kDecay = 0.5;
     // Decayed number of contributing samples a region needs before it adopts a candidate.
     static constexpr double kMinSamples = 32.0;
+    // Learned data per region once allocated (sums, weight, selection): the memory estimates
+    // of the backends count it for every region.
+    static constexpr double kBytesPerRegion =
+        kCandidates * sizeof(double) + sizeof(double) + sizeof(float);
 
     // `regions` regions, none learned.
     void reset(size_t regions);

@@ -7,6 +7,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "guiding/slot_merge.h"
+
 namespace rlpbrt::guiding {
 
 void StrataTable::reset(size_t regions, int strata, double init, const PolicyBuilder& policy) {
@@ -111,14 +113,9 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
     stats_.selectionRegions = selection_.learnedRegions();
     stats_.selectionMean = selection_.meanSelection();
     if (total > 0 && regions_ > 0) {
-        // Stable counting sort by region: within a region, records stay in slot order.
-        regionStart_.assign(regions_ + 1, 0);
-        for (const SlotBuffer& s : slots_)
-            for (const Record& r : s.records) ++regionStart_[r.region + 1];
-        for (size_t r = 0; r < regions_; ++r) regionStart_[r + 1] += regionStart_[r];
-        merged_.resize(total);
-        for (const SlotBuffer& s : slots_)
-            for (const Record& r : s.records) merged_[regionStart_[r.region]++] = r;
+        mergeByRegion<Record>(
+            slots_, [](const SlotBuffer& s) -> const std::vector<Record>& { return s.records; },
+            regions_, &regionStart_, &merged_);
         // regionStart_[r] now holds the end of region r.
         tbb::parallel_for(tbb::blocked_range<size_t>(0, regions_, 256),
                           [&](const tbb::blocked_range<size_t>& range) {

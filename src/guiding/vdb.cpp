@@ -74,7 +74,8 @@ double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
     const double regionsPerVoxel = params.sphere ? 1.0 : 2.0 * std::min(params.normals, 2);
     const double s = double(params.cols) * params.rows * (params.sphere ? 2.0 : 1.0);
     const double perRegion = s * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) +
-                             (s + 1) * sizeof(float) + sizeof(HemiFrame);
+                             (s + 1) * sizeof(float) + sizeof(HemiFrame) +
+                             SelectionLearner::kBytesPerRegion;
     // Per voxel: normals, offsets and about 8 bytes of OpenVDB tree (leaf values and masks).
     return voxels * (regionsPerVoxel * (perRegion + sizeof(int)) + 2 * sizeof(glm::vec3) + 12.0);
 }
@@ -83,7 +84,7 @@ double vdbMediumCellBytes(const VdbParams& params) {
     // Per stratum Q (double), float Q, visits and the CDF entry; per cell ~64 bytes more.
     return 2.0 * params.cols * params.rows *
                (sizeof(double) + 2 * sizeof(float) + sizeof(uint64_t)) +
-           64.0;
+           64.0 + SelectionLearner::kBytesPerRegion;
 }
 
 VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
