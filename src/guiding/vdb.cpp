@@ -443,7 +443,8 @@ float VdbField::radiance(int region, const glm::vec3& w) const {
 }
 
 float VdbField::selection(int region) const {
-    if (const int cell = volumeCell(region); cell >= 0) return volume_->selection().selection(size_t(cell));
+    if (const int cell = volumeCell(region); cell >= 0)
+        return volume_->selection().selection(size_t(cell));
     return validRegion(region) ? table_.selection().selection(size_t(region)) : -1.f;
 }
 

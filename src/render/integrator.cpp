@@ -115,8 +115,6 @@ bool guidable(const BSDF& bsdf) {
     return all > 0 && bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) == all;
 }
 
-// The pending training record of the last guided vertex: its region and direction, and the
-// target collected so far through delta vertices (weight = product of their f cos / pdf).
 // A guided vertex of the path whose direction sample feeds the selection learning (mix=learn):
 // the radiance the path gathers after it, over the throughput at it, is the sample's
 // contribution F = f cos Li / pdf, so its integrand is F * pdf (known when the path ends).
@@ -128,6 +126,8 @@ struct SelectionVertex {
 };
 constexpr int kMaxSelectionVertices = 16;
 
+// The pending training record of the last guided vertex: its region and direction, and the
+// target collected so far through delta vertices (weight = product of their f cos / pdf).
 struct PendingRecord {
     int region = -1;
     Vec3 w{0.f};
@@ -515,7 +515,6 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 pending = PendingRecord();
                 pending.region = region;
                 pending.w = ds.wi;
-
             } else if (pending.active() && region < 0 && !canGuide) {
                 pending.weight *= luminance(weight);  // through a delta vertex
             } else {
