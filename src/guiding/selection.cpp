@@ -1,5 +1,6 @@
 #include "guiding/selection.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 

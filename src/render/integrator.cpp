@@ -141,7 +141,7 @@ float PathIntegrator::directionPdf(const BSDF& bsdf, int region, float share, co
                                    const Vec3& wi) const {
     float pb = bsdf.pdf(wo, wi);
     if (region < 0) return pb;
-    const float mix = regionMix(region) * share;
+    const float mix = guideProbability(region, share);
     return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * pb : pb;
 }
 
@@ -163,8 +163,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
-    ds.scale = guide_.field->confidence(region) * share;
-    const float mix = regionSelection(region) * ds.scale;
+    const float mix = guideProbability(region, share, &ds.scale);
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
@@ -238,7 +237,7 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
 }
 
 float PathIntegrator::mediumDirectionPdf(float phase, int region, const Vec3& wi) const {
-    const float mix = regionMix(region);
+    const float mix = guideProbability(region, 1.f);
     return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * phase : phase;
 }
 
@@ -248,8 +247,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3
     DirectionSample ds;
     const float uc = guide_.field ? sampler.get1D() : 1.f;
     const Vec2 u = sampler.get2D();
-    ds.scale = region >= 0 ? guide_.field->confidence(region) : 0.f;
-    const float mix = region >= 0 ? regionSelection(region) * ds.scale : 0.f;
+    const float mix = guideProbability(region, 1.f, &ds.scale);
     float pGuide = 0.f, pPhase = 0.f;
     if (uc < mix) {
         ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide);

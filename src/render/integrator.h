@@ -79,16 +79,19 @@ private:
         float pGuide = 0.f, pOther = 0.f, scale = 0.f;
     };
     // `share`: the BSDF's diffuse share; the probability of a guided sample is
-    // regionMix(region) * share (region < 0: BSDF only). The region's confidence is read
-    // here, late, so that the lookup's prefetch of its cache line has landed.
+    // guideProbability(region, share) (region < 0: BSDF only). The region's confidence is
+    // read here, late, so that the lookup's prefetch of its cache line has landed.
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                                     float share, Sampler& sampler) const;
     float directionPdf(const BSDF& bsdf, int region, float share, const Vec3& wo,
                        const Vec3& wi) const;
-    // Probability of a guided sample at a region: the mix setting times the region's
-    // confidence (0 without a region).
-    float regionMix(int region) const {
-        return region >= 0 ? regionSelection(region) * guide_.field->confidence(region) : 0.f;
+    // Probability of a guided sample at a region: its selection times *scale = its
+    // confidence times `share` (the BSDF's diffuse share; 1 in a medium); 0 without a region.
+    // Sampling and pdf evaluation both call it, so they agree to the bit.
+    float guideProbability(int region, float share, float* scale = nullptr) const {
+        const float sc = region >= 0 ? guide_.field->confidence(region) * share : 0.f;
+        if (scale) *scale = sc;
+        return region >= 0 ? regionSelection(region) * sc : 0.f;
     }
     // The selection probability of a region: learned (mix=learn, where the field has one) or
     // the mix setting.
@@ -112,7 +115,7 @@ private:
     Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, int region,
                                const PathMedium& pm, Sampler& sampler, PathStats& stats) const;
     // The direction-sampling seam at a medium vertex: the phase function, or at a region the
-    // guide with probability regionMix, mixed with it (f = the phase value; one 1D dimension
+    // guide with probability guideProbability, mixed with it (f = the phase value; one 1D dimension
     // more when a field is set). And the pdf of that strategy for wi, whose phase value is
     // `phase`.
     DirectionSample sampleMediumDirection(const Vec3& wo, float g, int region,

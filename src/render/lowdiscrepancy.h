@@ -95,9 +95,10 @@ inline uint32_t owenScramble(uint32_t v, uint64_t seed) {
 }
 
 namespace detail {
-// Sixteen fixed random permutations of [0, 2^k) for k = 1..4 (3 and 4 in use) (Fisher-Yates driven by
+// Sixteen fixed random permutations of [0, 2^k) for k = 1..4 (Fisher-Yates driven by
 // splitmix64 from a fixed state, evaluated at compile time), entry j of a permutation in bits
-// 4j..4j+3: the S-boxes of the small-n permutations below.
+// 4j..4j+3: the S-boxes of the small-n permutations below. Only k = 3 and 4 are used; k = 1
+// and 2 stay in the generator's stream so that the boxes in use keep their values.
 struct SmallPermutationBoxes {
     uint64_t box[4][16];
 };

@@ -92,7 +92,9 @@ void checkAgainstPbrtV3(const std::string& id, const char* guide, bool media) {
     RenderResult result = render(*scene, ro);
     EXPECT_EQ(result.spp, 64);
     // With media, vdb guides at medium vertices too: it must have modelled the medium.
-    if (media && std::string(guide) == "vdb") EXPECT_GT(field->stats().mediumCells, 0u);
+    if (media && std::string(guide) == "vdb") {
+        EXPECT_GT(field->stats().mediumCells, 0u);
+    }
 
     Image ref;
     std::string err;
