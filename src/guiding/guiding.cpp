@@ -130,7 +130,7 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
     } else if (key == "max-mb") {
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
         *maxMiB = d;
-    } else if (key == "mix" || key == "target" || key == "samples") {
+    } else if (key == "mix" || key == "target" || key == "samples" || key == "auto") {
         // Consumed by the integrator and the render loop.
     } else {
         return 0;

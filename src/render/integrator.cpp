@@ -73,6 +73,17 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
         }
         settings->independentPasses = samples->second == "independent";
     }
+    auto autoSpp = config.params.find("auto");
+    if (autoSpp != config.params.end()) {
+        char* end = nullptr;
+        const long n = std::strtol(autoSpp->second.c_str(), &end, 10);
+        if (end == autoSpp->second.c_str() || *end != '\0' || n < 0 || n > (1L << 24)) {
+            *error = "auto must be a sample count in [0, 16777216] (0 = always guide), got \"" +
+                     autoSpp->second + "\"";
+            return false;
+        }
+        settings->autoSpp = int(n);
+    }
     if (config.backend == "none") return true;
     guiding::SceneInfo info;
     info.boundsMin = scene.boundsMin();

@@ -55,6 +55,12 @@ struct GuideSettings {
     // policy converges, +0.044% / +0.029% / +0.008% at 16 / 64 / 256 spp on a white
     // furnace (docs/STABILITY.md). Independent sets are exactly unbiased.
     bool independentPasses = false;
+    // auto=N (render loop): after about N samples per pixel, render one plain pass as large as
+    // the guided pass before it, compare the two passes' efficiencies (relative variance per
+    // sample times time per sample, render/efficiency.h) and render the rest without
+    // guiding (no lookups, no learning) if the plain pass was the more efficient. 0 = always
+    // guide.
+    int autoSpp = 0;
 };
 
 class Rng;

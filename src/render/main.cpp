@@ -289,6 +289,13 @@ int main(int argc, char** argv) {
                 j["guide_selection_regions"] = gs.selectionRegions;
                 j["guide_selection_mean"] = gs.selectionMean;
             }
+            const RenderResult::AutoTrial& at = r.autoTrial;
+            j["guide_auto"] = !at.ran ? "not run" : at.keptGuiding ? "kept" : "off";
+            j["guide_guided_spp"] = at.guidedSpp;
+            if (at.ran) {
+                j["guide_auto_guided_cost"] = at.guidedCost;
+                j["guide_auto_plain_cost"] = at.plainCost;
+            }
         }
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;

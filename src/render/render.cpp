@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <thread>
 #include <unistd.h>
@@ -13,6 +14,8 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include "render/efficiency.h"
 
 namespace rlpbrt {
 
@@ -58,8 +61,20 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // independentPasses) come from a set of the pass's own (Sampler::passSampler).
     // Measured at 64 spp (relMSE, hemi): doubling pass sizes gave veach-bidir 0.382 /
     // breakfast 4.73 against 0.345 / 4.46 with halves (independent sets).
-    const bool guided = field != nullptr;
+    bool guided = field != nullptr;
     constexpr int kMaxGuidedPass = 64;
+    // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
+    // that reaches autoSpp is measured, then a plain pass of the same size; the rest is
+    // rendered plain if that was more efficient (render/efficiency.h).
+    enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
+    Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
+    std::unique_ptr<PathIntegrator> plainIntegrator;
+    std::unique_ptr<PassMoments> guidedMoments, plainMoments;
+    // The pixel means of the passes before the trial: the trial's reference values.
+    std::unique_ptr<PassMoments> history =
+        trial == Trial::Pending ? std::make_unique<PassMoments>(film.sampleBounds()) : nullptr;
+    double guidedSecondsPerSample = 0.0;
+    int guidedCount = 0;
 
     tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers(
         [&] { return scene.sampler->clone(); });
@@ -74,6 +89,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     int pass = 0;
     for (;;) {
         int count = guided ? std::clamp(result.spp / 2, 1, kMaxGuidedPass) : 1;
+        if (trial == Trial::MeasurePlain) count = guidedCount;
         if (!timed) {
             count = std::min(count, totalSpp - result.spp);
         } else if (pass > 0) {
@@ -83,13 +99,36 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
         }
         if (count <= 0) break;
+        if (trial == Trial::Pending && count >= 2 &&
+            result.spp + count >= options.guide.autoSpp) {
+            trial = Trial::MeasureGuided;
+            guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
+        } else if (trial == Trial::MeasurePlain) {
+            if (count < 2) {
+                trial = Trial::Done;  // no room left for a plain pass to compare with
+                guidedMoments.reset();
+                history.reset();
+            } else {
+                plainMoments = std::make_unique<PassMoments>(film.sampleBounds());
+                if (!plainIntegrator)
+                    plainIntegrator = std::make_unique<PathIntegrator>(scene, GuideSettings());
+            }
+        }
+        const bool guidedPass = guided && trial != Trial::MeasurePlain;
+        // (Without a field, `integrator` is plain already.)
+        const PathIntegrator& passIntegrator =
+            guidedPass || !plainIntegrator ? integrator : *plainIntegrator;
+        PassMoments* moments = trial == Trial::MeasureGuided  ? guidedMoments.get()
+                               : trial == Trial::MeasurePlain ? plainMoments.get()
+                                                              : nullptr;
+        const double passStart = now();
         // An independent pass: its own sample set, indices from 0; otherwise the next samples
         // of the one sequence per pixel.
         const bool ownSet = guided && options.guide.independentPasses;
         const int first = ownSet ? 0 : result.spp;
         std::unique_ptr<Sampler> passProto =
             ownSet ? scene.sampler->passSampler(count, pass) : nullptr;
-        if (field) field->beginPass(int(tiles.size()));
+        if (guidedPass) field->beginPass(int(tiles.size()));
         arena.execute([&] {
             tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
                 std::unique_ptr<Sampler> passSampler = passProto ? passProto->clone() : nullptr;
@@ -98,14 +137,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 FilmTile& tile = *tileFilms[ti];
                 const Bounds2i& b = tiles[ti];
                 for (int y = b.pMin.y; y < b.pMax.y; ++y)
-                    for (int x = b.pMin.x; x < b.pMax.x; ++x)
+                    for (int x = b.pMin.x; x < b.pMax.x; ++x) {
+                        PixelMoments pixel;
+                        PassMoments* const into = moments ? moments : history.get();
+                        const bool measured = into && into->tracked(x, y);
                         for (int s = first; s < first + count; ++s) {
                             sampler.startPixelSample(x, y, s);
                             Vec2 pFilm = Vec2(float(x), float(y)) + sampler.getPixel2D();
                             Vec2 uLens = sampler.get2D();
                             CameraRay cr = scene.camera->generateRay(pFilm, uLens);
                             Spectrum L(0.f);
-                            if (cr.weight > 0.f) L = integrator.Li(cr.ray, sampler, st, int(ti));
+                            if (cr.weight > 0.f)
+                                L = passIntegrator.Li(cr.ray, sampler, st, int(ti));
                             ++st.paths;
                             if (!isFinite(L)) {
                                 ++st.nonFinite;
@@ -114,11 +157,44 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                                 ++st.zeroRadiancePaths;
                             }
                             tile.addSample(pFilm, L, cr.weight);
+                            if (measured) pixel.add(L * cr.weight);
                         }
+                        if (measured && moments)
+                            moments->set(x, y, pixel.n, pixel.sum, pixel.sumSq);
+                        else if (measured)
+                            history->accumulate(x, y, pixel.n, pixel.sum);
+                    }
             });
         });
         // The guide learns between passes: every pass samples from a frozen policy.
-        if (field) field->endPass();
+        if (guidedPass) field->endPass();
+        const double secondsPerSample =
+            (now() - passStart) / (double(pixelsPerPass) * double(count));
+        if (trial == Trial::MeasureGuided) {
+            trial = Trial::MeasurePlain;
+            guidedSecondsPerSample = secondsPerSample;
+            guidedCount = count;
+        } else if (trial == Trial::MeasurePlain) {
+            trial = Trial::Done;
+            const double rvGuided = guidedMoments->relativeVariance(*history);
+            const double rvPlain = plainMoments->relativeVariance(*history);
+            if (std::getenv("RLPBRT_TRIAL"))
+                std::fprintf(stderr, "trial: rv guided %.4g plain %.4g, s/sample guided %.4g plain %.4g\n",
+                             rvGuided, rvPlain, guidedSecondsPerSample, secondsPerSample);
+            if (rvGuided >= 0.0 && rvPlain >= 0.0) {
+                result.autoTrial.ran = true;
+                result.autoTrial.guidedCost = rvGuided * guidedSecondsPerSample;
+                result.autoTrial.plainCost = rvPlain * secondsPerSample;
+                if (result.autoTrial.plainCost < result.autoTrial.guidedCost) {
+                    guided = false;
+                    result.autoTrial.keptGuiding = false;
+                    result.autoTrial.guidedSpp = result.spp;
+                }
+            }
+            guidedMoments.reset();
+            plainMoments.reset();
+            history.reset();
+        }
         film.mergeTiles(tileFilms);
         for (auto& t : tileFilms) t->clear();
         result.spp += count;
@@ -134,6 +210,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             break;
         }
     }
+    if (result.autoTrial.keptGuiding) result.autoTrial.guidedSpp = field ? result.spp : 0;
     if (options.progress) std::fprintf(stderr, "\n");
     result.seconds = now() - start;
     for (const auto& s : stats) result.stats.add(s);

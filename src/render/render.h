@@ -28,6 +28,15 @@ struct RenderResult {
     double seconds = 0.0;   // render time (without parsing and building)
     PathStats stats;
     bool cancelled = false;
+    // The auto trial of a guided render (GuideSettings::autoSpp): whether it ran, its verdict,
+    // the spp at which guiding stopped (= spp if it never did), and the two passes' costs
+    // (relative variance per sample x seconds per sample).
+    struct AutoTrial {
+        bool ran = false;
+        bool keptGuiding = true;
+        int guidedSpp = 0;
+        double guidedCost = 0.0, plainCost = 0.0;
+    } autoTrial;
 };
 
 RenderResult render(const Scene& scene, const RenderOptions& options);

@@ -1,0 +1,86 @@
+#include "render/efficiency.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace rlpbrt {
+
+PassMoments::PassMoments(const Bounds2i& bounds, size_t maxPixels) : bounds_(bounds) {
+    width_ = bounds.width();
+    const size_t pixels = size_t(bounds.area());
+    maxPixels = std::max<size_t>(maxPixels, 1);
+    rowStride_ = std::max(1L, long((pixels + maxPixels - 1) / maxPixels));
+    const long rows = (long(bounds.height()) + rowStride_ - 1) / rowStride_;
+    const size_t n = size_t(rows) * size_t(width_);
+    mean_.assign(3 * n, 0.f);
+    var_.assign(3 * n, 0.f);
+    count_.assign(n, 0);
+}
+
+long PassMoments::slot(int x, int y) const {
+    if (!bounds_.contains(glm::ivec2(x, y))) return -1;
+    const long row = long(y - bounds_.pMin.y);
+    return row % rowStride_ == 0 ? (row / rowStride_) * width_ + long(x - bounds_.pMin.x) : -1;
+}
+
+void PassMoments::set(int x, int y, int n, const double sum[3], const double sumSq[3]) {
+    const long s = slot(x, y);
+    if (s < 0 || n <= 0) return;
+    count_[size_t(s)] = n;
+    for (int c = 0; c < 3; ++c) {
+        const double m = sum[c] / n;
+        const double v = n > 1 ? std::max(0.0, (sumSq[c] - sum[c] * m) / (n - 1)) : 0.0;
+        mean_[size_t(s) * 3 + size_t(c)] = float(m);
+        var_[size_t(s) * 3 + size_t(c)] = float(v);
+    }
+}
+
+void PassMoments::accumulate(int x, int y, int n, const double sum[3]) {
+    const long s = slot(x, y);
+    if (s < 0 || n <= 0) return;
+    const int before = count_[size_t(s)];
+    const int total = before + n;
+    for (size_t c = 0; c < 3; ++c) {
+        float& m = mean_[size_t(s) * 3 + c];
+        m = float((double(m) * before + sum[c]) / total);
+    }
+    count_[size_t(s)] = total;
+}
+
+double PassMoments::relativeVariance(const PassMoments& other) const {
+    if (!(bounds_ == other.bounds_) || rowStride_ != other.rowStride_) return -1.0;
+    std::vector<double> rv;
+    rv.reserve(count_.size());
+    for (size_t i = 0; i < count_.size(); ++i) {
+        if (count_[i] < 2) continue;
+        // The reference: median of the set means among the pixel and two neighbours on either
+        // side in its row.
+        const long x = long(i) % width_, rowStart = long(i) - x;
+        float near[3][5];
+        int k = 0;
+        for (long dx = -2; dx <= 2; ++dx) {
+            const long xx = x + dx;
+            if (xx < 0 || xx >= width_ || other.count_[size_t(rowStart + xx)] < 1) continue;
+            for (size_t c = 0; c < 3; ++c) near[c][k] = other.mean_[size_t(rowStart + xx) * 3 + c];
+            ++k;
+        }
+        if (k == 0) continue;
+        double sum = 0.0;
+        for (size_t c = 0; c < 3; ++c) {
+            std::nth_element(near[c], near[c] + k / 2, near[c] + k);
+            const double m = double(near[c][k / 2]);
+            sum += double(var_[i * 3 + c]) / (m * m + 0.01);
+        }
+        if (std::isfinite(sum)) rv.push_back(sum / 3.0);
+    }
+    if (rv.empty()) return -1.0;
+    static const size_t div = std::getenv("RV_TRIM") ? size_t(std::atol(std::getenv("RV_TRIM"))) : 1000;
+    const size_t keep = rv.size() - (div ? rv.size() / div : 0);
+    if (keep < rv.size()) std::nth_element(rv.begin(), rv.begin() + long(keep - 1), rv.end());
+    double total = 0.0;
+    for (size_t i = 0; i < keep; ++i) total += rv[i];
+    return total / double(keep);
+}
+
+}  // namespace rlpbrt
