@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace rlpbrt {
 
@@ -75,12 +74,21 @@ double PassMoments::relativeVariance(const PassMoments& other) const {
         if (std::isfinite(sum)) rv.push_back(sum / 3.0);
     }
     if (rv.empty()) return -1.0;
-    static const size_t div = std::getenv("RV_TRIM") ? size_t(std::atol(std::getenv("RV_TRIM"))) : 1000;
-    const size_t keep = rv.size() - (div ? rv.size() / div : 0);
-    if (keep < rv.size()) std::nth_element(rv.begin(), rv.begin() + long(keep - 1), rv.end());
-    double total = 0.0;
-    for (size_t i = 0; i < keep; ++i) total += rv[i];
-    return total / double(keep);
+    // Median of the means of kGroups interleaved pixel groups: a single extreme sample (which
+    // a trimmed mean would drop with the pixel, and which would decide a plain mean) moves
+    // one group; light that many pixels receive rarely still moves them all.
+    constexpr size_t kGroups = 15;
+    double sums[kGroups] = {}, means[kGroups] = {};
+    size_t counts[kGroups] = {};
+    for (size_t i = 0; i < rv.size(); ++i) {
+        sums[i % kGroups] += rv[i];
+        ++counts[i % kGroups];
+    }
+    size_t groups = 0;
+    for (size_t g = 0; g < kGroups; ++g)
+        if (counts[g] > 0) means[groups++] = sums[g] / double(counts[g]);
+    std::nth_element(means, means + groups / 2, means + groups);
+    return means[groups / 2];
 }
 
 }  // namespace rlpbrt

@@ -28,14 +28,17 @@ public:
     // passes; the variance is not kept).
     void accumulate(int x, int y, int n, const double sum[3]);
 
-    // The trimmed mean over tracked pixels of (1/3) sum_c var_c / (m_c^2 + 0.01): var_c the
+    // The relative variance of one sample: over the tracked pixels, the median of the means
+    // of 15 interleaved pixel groups of (1/3) sum_c var_c / (m_c^2 + 0.01), var_c the
     // per-sample variance in this pass, m_c the median of `reference`'s means (earlier
-    // passes) of the pixel and its two neighbours on either side in its row, the largest 0.1%
-    // of pixel values dropped as relMseTrimmed drops errors. (A mean from the same samples
-    // would cancel a pixel's outliers against themselves; the median keeps an outlier of the
-    // earlier passes from hiding this pass's variance.) An n-sample
-    // estimate of the pixels has about this relMSE / n. -1 if nothing was set or the
-    // rectangles differ.
+    // passes) of the pixel and its two neighbours on either side in its row (relMseTrimmed's
+    // normalisation). An n-sample estimate of the pixels has about this relMSE / n. -1 if
+    // nothing was set or the rectangles differ. Why so: a mean from the pass's own samples
+    // would cancel a pixel's outliers against themselves, and the median keeps an outlier of
+    // the earlier passes from hiding this pass's variance; the trimmed mean of relMseTrimmed
+    // drops exactly the pixels where a pass of few samples caught rare light (it judged
+    // plain rendering better on veach-bidir and breakfast, where guiding wins), and a plain
+    // mean is decided by single samples (docs/BENCHMARKS.md, "Guided or plain: a trial").
     double relativeVariance(const PassMoments& reference) const;
 
 private:

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <mutex>
 #include <thread>
 #include <unistd.h>
@@ -67,6 +66,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // that reaches autoSpp is measured, then a plain pass of the same size; the rest is
     // rendered plain if that was more efficient (render/efficiency.h).
     enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
+    constexpr double kAutoMargin = 1.15;
     Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
     std::unique_ptr<PathIntegrator> plainIntegrator;
     std::unique_ptr<PassMoments> guidedMoments, plainMoments;
@@ -178,14 +178,13 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             trial = Trial::Done;
             const double rvGuided = guidedMoments->relativeVariance(*history);
             const double rvPlain = plainMoments->relativeVariance(*history);
-            if (std::getenv("RLPBRT_TRIAL"))
-                std::fprintf(stderr, "trial: rv guided %.4g plain %.4g, s/sample guided %.4g plain %.4g\n",
-                             rvGuided, rvPlain, guidedSecondsPerSample, secondsPerSample);
             if (rvGuided >= 0.0 && rvPlain >= 0.0) {
                 result.autoTrial.ran = true;
                 result.autoTrial.guidedCost = rvGuided * guidedSecondsPerSample;
                 result.autoTrial.plainCost = rvPlain * secondsPerSample;
-                if (result.autoTrial.plainCost < result.autoTrial.guidedCost) {
+                // Guiding must be clearly worse to be dropped: the guide is still learning,
+                // and the estimate spreads (docs/BENCHMARKS.md).
+                if (result.autoTrial.guidedCost > kAutoMargin * result.autoTrial.plainCost) {
                     guided = false;
                     result.autoTrial.keptGuiding = false;
                     result.autoTrial.guidedSpp = result.spp;

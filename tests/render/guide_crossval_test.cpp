@@ -22,6 +22,7 @@ namespace {
 struct Rendered {
     Image image;
     guiding::GuidingStats stats;
+    RenderResult::AutoTrial autoTrial;
 };
 
 Rendered renderWith(const std::string& scenePath, const char* backend, int spp,
@@ -45,7 +46,9 @@ Rendered renderWith(const std::string& scenePath, const char* backend, int spp,
     EXPECT_TRUE(setupGuiding(*scene, gc, &field, &ro.guide, &err)) << err;
     ro.nThreads = 1;  // CTest runs tests in parallel
     Rendered out;
-    out.image = render(*scene, ro).image;
+    RenderResult r = render(*scene, ro);
+    out.image = std::move(r.image);
+    out.autoTrial = r.autoTrial;
     if (field) out.stats = field->stats();
     return out;
 }
@@ -125,9 +128,12 @@ TEST(GuideCrossValidation, IntegratorParametersAreValidated) {
     EXPECT_FALSE(gs.learnMix);
     EXPECT_FALSE(gs.independentPasses);
     EXPECT_FLOAT_EQ(gs.mix, 0.25f);
+    EXPECT_EQ(gs.autoSpp, 0);  // always guide unless asked
+    ASSERT_TRUE(setup({{"auto", "16"}}, &gs, &err)) << err;
+    EXPECT_EQ(gs.autoSpp, 16);
     for (const auto& bad : std::vector<std::map<std::string, std::string>>{
              {{"mix", "learnt"}}, {{"mix", "1.5"}}, {{"samples", "random"}},
-             {{"target", "all"}}}) {
+             {{"target", "all"}}, {{"auto", "-1"}}, {{"auto", "16x"}}, {{"auto", ""}}}) {
         err.clear();
         EXPECT_FALSE(setup(bad, &gs, &err)) << bad.begin()->first;
         EXPECT_NE(err.find(bad.begin()->first), std::string::npos) << err;
@@ -160,6 +166,17 @@ TEST(GuideCrossValidation, GuidedPassesContinueThePixelSequence) {
     };
     EXPECT_LT(relDiff(seq.image), 1e-5);
     EXPECT_GT(relDiff(own.image), 1e-2);
+
+    // The auto trial's plain pass and the plain passes after it continue the same sequence:
+    // with mix=0 the guided passes sample as plain ones do, so guided and plain cost the same
+    // per sample up to the learning, the trial runs (at 4 spp: guided pass 4..6, plain pass
+    // 6..8) and the image still equals the plain render, whatever its verdict.
+    Rendered trial = renderWith(scene, "hemi", spp, {{"mix", "0"}, {"auto", "4"}});
+    EXPECT_TRUE(trial.autoTrial.ran);
+    EXPECT_GT(trial.autoTrial.guidedCost, 0.0);
+    EXPECT_GT(trial.autoTrial.plainCost, 0.0);
+    EXPECT_EQ(trial.autoTrial.guidedSpp, trial.autoTrial.keptGuiding ? spp : 6);
+    EXPECT_LT(relDiff(trial.image), 1e-5);
 }
 
 }  // namespace
