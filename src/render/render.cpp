@@ -64,7 +64,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     constexpr int kMaxGuidedPass = 64;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
     // that reaches autoSpp is measured, then a plain pass of the same size; the rest is
-    // rendered plain if that was more efficient (render/efficiency.h).
+    // rendered plain if the guided pass cost more than kAutoMargin times the plain one per
+    // unit of variance (render/efficiency.h).
     enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
     constexpr double kAutoMargin = 1.15;
     Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
