@@ -55,13 +55,14 @@ struct GuideSettings {
     // policy converges, +0.044% / +0.029% / +0.008% at 16 / 64 / 256 spp on a white
     // furnace (docs/STABILITY.md). Independent sets are exactly unbiased.
     bool independentPasses = false;
-    // auto=N (render loop, opt-in): after about N samples per pixel, render one plain pass as
-    // large as the guided pass before it, compare the two passes' costs (relative variance
-    // per sample times time per sample, render/efficiency.h) and render the rest without
-    // guiding (no lookups, no learning) if the guided cost exceeds 1.15 times the plain one.
-    // 0 (default) = always guide. Measured at N = 16, 96 spp, seeds 1/2/3 (guided/plain
-    // cost): killeroo 1.45/1.47/1.38, cornell-box 1.38/1.43/1.35, conference 1.23/1.27/1.24,
-    // veach-bidir 0.56/1.05/1.10, breakfast 0.62/3.24/0.45 (docs/BENCHMARKS.md).
+    // auto=N (render loop): after about N samples per pixel (or a quarter of a time budget),
+    // render one plain pass as large as the guided pass before it, compare the two passes'
+    // costs (relative variance per sample times CPU seconds per sample, render/efficiency.h)
+    // and render the rest without guiding (no lookups, no learning) if the guided cost
+    // exceeds 1.15 times the plain one. 0 = always guide (the default here; the command line
+    // passes 16). Measured at N = 16, 96 spp, seeds 1/2/3 (guided/plain cost): killeroo
+    // 1.45/1.47/1.38, cornell-box 1.38/1.43/1.35, conference 1.23/1.27/1.24, veach-bidir
+    // 0.56/1.05/1.10, breakfast 0.62/3.24/0.45 (docs/BENCHMARKS.md).
     int autoSpp = 0;
 };
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <mutex>
 #include <thread>
 #include <unistd.h>
@@ -23,6 +24,14 @@ namespace {
 double now() {
     using namespace std::chrono;
     return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+// CPU seconds of the process (all threads): the auto trial's cost of a pass, which other
+// processes on the machine then affect less than wall time.
+double cpuNow() {
+    timespec ts{};
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return now();
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 void printProgress(int pass, int spp, int totalSpp, double elapsed, double budget,
@@ -63,7 +72,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     bool guided = field != nullptr;
     constexpr int kMaxGuidedPass = 64;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
-    // that reaches autoSpp is measured, then a plain pass of the same size; the rest is
+    // that reaches autoSpp (or a quarter of a time budget) is measured, then a plain pass of the same size; the rest is
     // rendered plain if the guided pass cost more than kAutoMargin times the plain one per
     // unit of variance (render/efficiency.h).
     enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
@@ -100,8 +109,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
         }
         if (count <= 0) break;
+        // The trial starts at autoSpp, or a quarter into a time budget if that comes first.
         if (trial == Trial::Pending && count >= 2 &&
-            result.spp + count >= options.guide.autoSpp) {
+            (result.spp + count >= options.guide.autoSpp ||
+             (timed && now() - start >= 0.25 * options.timeBudget))) {
             trial = Trial::MeasureGuided;
             guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
         } else if (trial == Trial::MeasurePlain) {
@@ -122,7 +133,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         PassMoments* moments = trial == Trial::MeasureGuided  ? guidedMoments.get()
                                : trial == Trial::MeasurePlain ? plainMoments.get()
                                                               : nullptr;
-        const double passStart = now();
+        const double passStart = cpuNow();
         // An independent pass: its own sample set, indices from 0; otherwise the next samples
         // of the one sequence per pixel.
         const bool ownSet = guided && options.guide.independentPasses;
@@ -170,7 +181,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         // The guide learns between passes: every pass samples from a frozen policy.
         if (guidedPass) field->endPass();
         const double secondsPerSample =
-            (now() - passStart) / (double(pixelsPerPass) * double(count));
+            (cpuNow() - passStart) / (double(pixelsPerPass) * double(count));
         if (trial == Trial::MeasureGuided) {
             trial = Trial::MeasurePlain;
             guidedSecondsPerSample = secondsPerSample;

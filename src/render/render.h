@@ -30,7 +30,7 @@ struct RenderResult {
     bool cancelled = false;
     // The auto trial of a guided render (GuideSettings::autoSpp): whether it ran, its verdict,
     // the spp at which guiding stopped (= spp if it never did), and the two passes' costs
-    // (relative variance per sample x seconds per sample).
+    // (relative variance per sample x CPU seconds per sample).
     struct AutoTrial {
         bool ran = false;
         bool keptGuiding = true;
