@@ -1,6 +1,7 @@
 // --guide-save / --guide-load through the command line: a saved field loads into a new run of
 // the same scene and backend; another scene, another backend or a bad file is an error with a
-// clear message and exit status 1; --stats reports the vdb grid's active voxels.
+// clear message and exit status 1; --stats reports the vdb grid's active voxels. The command
+// line runs the guided-or-plain trial by default, and auto=0 turns it off.
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -105,6 +106,34 @@ TEST(GuideFileCli, SaveLoadAndMismatchErrors) {
 
     for (const char* f : {"a.pbrt", "b.pbrt", "out.exr", "s.json", "field.vdb", "field.hemi"})
         std::remove((dir + "/" + f).c_str());
+    rmdir(dir.c_str());
+}
+
+TEST(GuideFileCli, TheTrialRunsByDefault) {
+    char tmpl[] = "/tmp/rlpbrt-guideauto-XXXXXX";
+    const std::string dir = mkdtemp(tmpl) ? tmpl : "/tmp";
+    const std::string scene = writeScene(dir + "/a.pbrt", false);
+    const std::string stats = dir + "/s.json";
+    const std::string a = scene + " --spp 32 --nthreads 1 --quiet -o " + dir + "/out.exr --stats " +
+                          stats + " ";
+    // At 32 spp: guided passes to 19 spp (the trial's guided pass is 13..19), a plain pass
+    // to 25, then one way or the other.
+    CliRun byDefault = run(a + "--guide=hemi");
+    ASSERT_EQ(byDefault.status, 0) << byDefault.output;
+    std::string json = slurp(stats);
+    EXPECT_TRUE(json.find("\"guide_auto\": \"kept\"") != std::string::npos ||
+                json.find("\"guide_auto\": \"off\"") != std::string::npos)
+        << json;
+    EXPECT_NE(json.find("\"guide_auto_plain_cost\""), std::string::npos) << json;
+    CliRun always = run(a + "--guide=vdb --guide-param auto=0");
+    ASSERT_EQ(always.status, 0) << always.output;
+    json = slurp(stats);
+    EXPECT_NE(json.find("\"guide_auto\": \"not run\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"guide_guided_spp\": 32"), std::string::npos) << json;
+    CliRun bad = run(a + "--guide=hemi --guide-param auto=x");
+    EXPECT_EQ(bad.status, 1) << bad.output;
+    EXPECT_NE(bad.output.find("auto must be"), std::string::npos) << bad.output;
+    for (const char* f : {"a.pbrt", "out.exr", "s.json"}) std::remove((dir + "/" + f).c_str());
     rmdir(dir.c_str());
 }
 
