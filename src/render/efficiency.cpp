@@ -47,8 +47,8 @@ void PassMoments::accumulate(int x, int y, int n, const double sum[3]) {
     count_[size_t(s)] = total;
 }
 
-double PassMoments::relativeVariance(const PassMoments& other) const {
-    if (!(bounds_ == other.bounds_) || rowStride_ != other.rowStride_) return -1.0;
+double PassMoments::relativeVariance(const PassMoments& reference) const {
+    if (!(bounds_ == reference.bounds_) || rowStride_ != reference.rowStride_) return -1.0;
     std::vector<double> rv;
     rv.reserve(count_.size());
     for (size_t i = 0; i < count_.size(); ++i) {
@@ -60,8 +60,8 @@ double PassMoments::relativeVariance(const PassMoments& other) const {
         int k = 0;
         for (long dx = -2; dx <= 2; ++dx) {
             const long xx = x + dx;
-            if (xx < 0 || xx >= width_ || other.count_[size_t(rowStart + xx)] < 1) continue;
-            for (size_t c = 0; c < 3; ++c) near[c][k] = other.mean_[size_t(rowStart + xx) * 3 + c];
+            if (xx < 0 || xx >= width_ || reference.count_[size_t(rowStart + xx)] < 1) continue;
+            for (size_t c = 0; c < 3; ++c) near[c][k] = reference.mean_[size_t(rowStart + xx) * 3 + c];
             ++k;
         }
         if (k == 0) continue;

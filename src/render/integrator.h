@@ -60,10 +60,11 @@ struct GuideSettings {
     // costs (relative variance per sample times CPU seconds per sample, render/efficiency.h)
     // and render the rest without guiding (no lookups, no learning) if the guided cost
     // exceeds 1.15 times the plain one. 0 = always guide (the default here; the command line
-    // passes 16). Measured at N = 16, 96 spp, seeds 1/2/3 (guided/plain cost): killeroo
+    // passes kCommandLineAutoSpp). Measured at N = 16, 96 spp, seeds 1/2/3 (guided/plain cost): killeroo
     // 1.45/1.47/1.38, cornell-box 1.38/1.43/1.35, conference 1.23/1.27/1.24, veach-bidir
     // 0.56/1.05/1.10, breakfast 0.62/3.24/0.45 (docs/BENCHMARKS.md).
     int autoSpp = 0;
+    static constexpr int kCommandLineAutoSpp = 16;
 };
 
 class Rng;
