@@ -155,10 +155,14 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
                 return badValue("hemi", key, value, "a number in [0, 1e9]", error);
             hp->warmup = d;
+        } else if (key == "lookup") {
+            if (value != "cell" && value != "exact")
+                return badValue("hemi", key, value, "cell or exact", error);
+            hp->cellLookup = value == "cell";
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, warmup, max-mb, mix, target)";
+                     "cosine, warmup, lookup, max-mb, mix, target, samples, auto)";
             return false;
         }
     }

@@ -23,8 +23,10 @@ double hemiEstimatedBytes(const HemiParams& p) {
         n * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) + (n + 1) * sizeof(float) +
         64.0 +  // RegionFrame
         SelectionLearner::kBytesPerRegion;
-    // Per point: position, normal, the tree's copy, its index entry and a share of the nodes.
-    const double perPoint = 3 * sizeof(glm::vec3) + sizeof(uint32_t) + 8.0;
+    // Per point: position, normal, the tree's copy, its index entry and a share of the nodes,
+    // and up to 16 entries of the lookup's cell memo (8, rounded up to a power of two).
+    const double perPoint = 3 * sizeof(glm::vec3) + sizeof(uint32_t) + 8.0 +
+                            (p.cellLookup ? 16.0 * 64.0 : 0.0);
     return double(p.points) * (2.0 * perRegion + perPoint);
 }
 
@@ -67,6 +69,15 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         normals_.swap(nrm);
     }
     tree_ = std::make_unique<PointKdTree>(positions_);
+    if (params_.cellLookup && !positions_.empty() && params_.knn <= CellCache::kMaxCandidates) {
+        // Cells as large as the points' mean spacing: about one to three cells per point's
+        // share of the surface (more where it runs oblique to the axes), so eight entries
+        // per point leave the table at most three quarters full on usual scenes.
+        const double spacing =
+            std::sqrt(std::max(scene.totalArea, 0.0) / double(positions_.size()));
+        cache_ = std::make_unique<CellCache>(scene.boundsMin, scene.boundsMax, float(spacing),
+                                             positions_.size() * 8, params_.knn);
+    }
 
     const size_t regions = positions_.size() * 2;
     frames_.resize(regions);
@@ -80,23 +91,36 @@ HemiField::~HemiField() = default;
 int HemiField::lookup(const glm::vec3& p, const glm::vec3& n) const {
     if (positions_.empty() || !finite3(p)) return -1;
     const float nLen = glm::length(n);
-    if (!(nLen > 0.f)) return -1;
+    if (!(nLen > 0.f) || !std::isfinite(nLen)) return -1;
     const float threshold = cosMaxAngle_ * nLen;
-    // Fast path: the nearest point is usually admissible, and a 1-NN query is much cheaper.
-    float d2 = 0.f;
-    const int nearest = tree_->nearest(p, &d2);
-    if (nearest >= 0) {
-        float c = glm::dot(n, normals_[size_t(nearest)]);
-        if (std::abs(c) >= threshold) return prefetched(nearest * 2 + (c >= 0.f ? 0 : 1));
-        if (params_.knn == 1) return -1;
-    }
     uint32_t idx[PointKdTree::kMaxK];
     float dist2[PointKdTree::kMaxK];
-    const int found = tree_->knn(p, params_.knn, idx, dist2);
+    const uint32_t* candidates = idx;
+    int found = 0;
+    if (cache_) {
+        // The knn points of the cell's centre, nearest to it first.
+        found = cache_->candidates(
+            p,
+            [this, &dist2](const glm::vec3& centre, uint32_t* dest) {
+                return tree_->knn(centre, params_.knn, dest, dist2);
+            },
+            idx, &candidates);
+    } else {
+        // Fast path: the nearest point is usually admissible, and a 1-NN query is cheaper.
+        float d2 = 0.f;
+        const int nearest = tree_->nearest(p, &d2);
+        if (nearest >= 0) {
+            const float c = glm::dot(n, normals_[size_t(nearest)]);
+            if (std::abs(c) >= threshold) return prefetched(nearest * 2 + (c >= 0.f ? 0 : 1));
+            if (params_.knn == 1) return -1;
+        }
+        found = tree_->knn(p, params_.knn, idx, dist2);
+    }
     for (int i = 0; i < found; ++i) {
-        float c = glm::dot(n, normals_[idx[i]]);
+        const float c = glm::dot(n, normals_[candidates[i]]);
         // Of the point's two hemispheres (n, -n), take the closer one if it is admissible.
-        if (std::abs(c) >= threshold) return prefetched(int(idx[i]) * 2 + (c >= 0.f ? 0 : 1));
+        if (std::abs(c) >= threshold)
+            return prefetched(int(candidates[i]) * 2 + (c >= 0.f ? 0 : 1));
     }
     return -1;
 }
@@ -222,7 +246,8 @@ void HemiField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlp
 
 size_t HemiField::bytes() const {
     return table_.bytes() + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
-           frames_.capacity() * sizeof(RegionFrame) + tree_->bytes();
+           frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +
+           (cache_ ? cache_->bytes() : 0);
 }
 
 size_t HemiField::scratchBytes() const { return table_.scratchBytes(); }

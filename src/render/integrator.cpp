@@ -58,11 +58,13 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     }
     auto target = config.params.find("target");
     if (target != config.params.end()) {
-        if (target->second != "sum" && target->second != "sample") {
-            *error = "target must be \"sum\" or \"sample\", got \"" + target->second + "\"";
+        if (target->second != "sum" && target->second != "sample" && target->second != "path") {
+            *error = "target must be \"sum\", \"sample\" or \"path\", got \"" +
+                     target->second + "\"";
             return false;
         }
-        settings->sampledTarget = target->second == "sample";
+        settings->sampledTarget = target->second != "sum";
+        settings->pathTarget = target->second == "path";
     }
     auto samples = config.params.find("samples");
     if (samples != config.params.end()) {
@@ -136,6 +138,19 @@ struct SelectionVertex {
     float lumBeta;  // luminance of the throughput at the vertex
 };
 constexpr int kMaxSelectionVertices = 16;
+
+// A guided vertex trained with the path's return (target=path): the radiance gathered after
+// it over the throughput after its direction sample is the incident radiance it received
+// from that direction, up to the MIS weight of the emission found right after it, whose
+// remainder extraLe restores (Q is the total incident radiance, NEE or not).
+struct ReturnVertex {
+    int region;
+    Vec3 w;
+    Spectrum L;     // L when the direction was sampled (after the vertex's NEE)
+    Spectrum beta;  // throughput after the direction's weight
+    float extraLe;  // (1 - MIS weight) x luminance of the emission hit next
+};
+constexpr int kMaxReturnVertices = 32;
 
 // The pending training record of the last guided vertex: its region and direction, and the
 // target collected so far through delta vertices (weight = product of their f cos / pdf).
@@ -338,6 +353,17 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     SelectionVertex selVerts[kMaxSelectionVertices];
     int numSelVerts = 0;
     const bool learnSelection = learn && guide_.learnMix;
+    // Training targets: Eq. 1 bootstrapped at the next vertex (pending), or the path's return.
+    const bool bootstrap = learn && !guide_.pathTarget;
+    const bool returns = learn && guide_.pathTarget;
+    ReturnVertex retVerts[kMaxReturnVertices];
+    int numRet = 0, openRet = -1;  // openRet: the return vertex the current ray left from
+    auto pushReturn = [&](int region, const Vec3& w) {
+        openRet = -1;
+        if (!returns || region < 0 || numRet >= kMaxReturnVertices) return;
+        retVerts[numRet] = ReturnVertex{region, w, L, beta, 0.f};
+        openRet = numRet++;
+    };
     auto pushSelection = [&](int region, const DirectionSample& ds) {
         if (!learnSelection || region < 0 || numSelVerts >= kMaxSelectionVertices) return;
         selVerts[numSelVerts++] = SelectionVertex{
@@ -391,7 +417,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 ++stats.vertices;
                 L += beta * sampleLightMedium(p, wo, medium.g(), sampleRegion, pm, sampler, stats);
                 DirectionSample ds = sampleMediumDirection(wo, medium.g(), sampleRegion, sampler);
-                if (learn) {
+                if (bootstrap) {
                     // Eq. 1 for the previous vertex, with the one-sample estimate of the
                     // light scattered here: Q(p, w') phase(w') / pdf(w').
                     if (pending.active() && region >= 0 && ds.pdf > 0.f) {
@@ -408,6 +434,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 pushSelection(sampleRegion, ds);
                 const Vec3 wi = ds.wi;
                 beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
+                pushReturn(region, wi);
                 dirPdf = ds.pdf;
                 specularBounce = false;
                 prev = LightSampleContext{p, Vec3(0.f)};
@@ -435,10 +462,12 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 } else {
                     float lightPdf = lights_->pmf(prev.p, idx) *
                                      light.pdfLi(prev, ray.d, Vec3(0.f), Vec3(0.f));
-                    L += beta * Le * powerHeuristic(1, dirPdf, 1, lightPdf);
+                    const float w = powerHeuristic(1, dirPdf, 1, lightPdf);
+                    L += beta * Le * w;
+                    if (openRet >= 0) retVerts[openRet].extraLe += (1.f - w) * luminance(Le);
                 }
             }
-            if (learn) flush(envLum);
+            if (bootstrap) flush(envLum);
             break;
         }
         float emitted = 0.f;
@@ -452,7 +481,9 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 } else {
                     float lightPdf = lights_->pmf(prev.p, si.light) *
                                      light.pdfLi(prev, ray.d, si.p, si.ng);
-                    L += beta * Le * powerHeuristic(1, dirPdf, 1, lightPdf);
+                    const float w = powerHeuristic(1, dirPdf, 1, lightPdf);
+                    L += beta * Le * w;
+                    if (openRet >= 0) retVerts[openRet].extraLe += (1.f - w) * emitted;
                 }
             }
         }
@@ -491,7 +522,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
         // y, carried unchanged through delta vertices.
         bool deferTarget = false;
-        if (learn && pending.active()) {
+        if (bootstrap && pending.active()) {
             float scattered = region >= 0 ? scatteredTarget(si, bsdf, region, si.wo) : 0.f;
             if (region >= 0 && scattered < 0.f && !lastVertex)
                 deferTarget = true;  // completed below with the direction sampled at y
@@ -519,7 +550,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         beta *= weight;
         dirPdf = ds.pdf;
         specularBounce = ds.specular;
-        if (learn) {
+        pushReturn(ds.transmission ? -1 : region, ds.wi);
+        if (bootstrap) {
             if (region >= 0 && !ds.transmission) {
                 pending = PendingRecord();
                 pending.region = region;
@@ -547,6 +579,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             if (sampler.get1D() < q) break;
             beta /= 1.f - q;
         }
+    }
+    for (int i = 0; i < numRet; ++i) {
+        const ReturnVertex& v = retVerts[i];
+        const Spectrum d = L - v.L;
+        Spectrum li(0.f);
+        for (int c = 0; c < 3; ++c) li[c] = v.beta[c] > 0.f ? d[c] / v.beta[c] : 0.f;
+        field->record(slot, v.region, v.w, std::max(luminance(li), 0.f) + v.extraLe);
     }
     if (numSelVerts > 0) {
         const float lumL = luminance(L);

@@ -45,6 +45,11 @@ struct GuideSettings {
     // (Q(y, w') f cos / pdf: an unbiased one-sample estimate of the same sum, no extra
     // evaluations). Lambertian vertices always use the exact sum (learned irradiance).
     bool sampledTarget = true;
+    // target=path: train on the radiance the rest of the path actually brought back to a
+    // guided vertex (a Monte Carlo return, as practical path guiding does) instead of
+    // bootstrapping Eq. 1 from Q at the next vertex: no propagation delay of one bounce per
+    // pass, noisier targets.
+    bool pathTarget = false;
     // Where a guided render's passes take their samples (samples=sequence|independent):
     // from the one low-discrepancy sequence per pixel that plain rendering uses (false, the
     // default), or from an independently randomized set per pass (true). The sequence

@@ -171,7 +171,10 @@ TEST(HemiField, DefaultsAndMemory) {
     // Q (double), visits (uint64), CDF (65 floats), frame and moment per region dominate.
     const size_t tables = size_t(f->numRegions()) * (64 * 20 + 65 * 4 + 64);
     EXPECT_GE(f->bytes(), tables);
-    EXPECT_LE(f->bytes(), tables + 2048 * 64);
+    // Points, tree and the lookup's cell memo: 16384 entries of one cache line.
+    ASSERT_NE(f->cellCache(), nullptr);
+    EXPECT_EQ(f->cellCache()->bytes(), 2048u * 8u * 64u);
+    EXPECT_LE(f->bytes(), tables + 2048 * 64 + f->cellCache()->bytes());
     EXPECT_LE(double(f->bytes()), 1.05 * hemiEstimatedBytes(f->params()));
     EXPECT_FALSE(f->describe().empty());
     // Record buffers are scratch, reported apart from the learned data.
@@ -220,7 +223,8 @@ TEST(HemiField, LookupOnPlaneSidesAndAngle) {
 
 TEST(HemiField, LookupReturnsNearestAdmissibleAmongKNearest) {
     for (int knn : {1, 8, 64}) {
-        auto f = makeHemi(cornerScene(), {{"points", "2000"}, {"knn", std::to_string(knn)}});
+        auto f = makeHemi(cornerScene(), {{"points", "2000"}, {"knn", std::to_string(knn)},
+                                          {"lookup", "exact"}});
         ASSERT_TRUE(f);
         const int points = f->numRegions() / 2;
         const float cosMax = std::cos(30.f * 3.14159265f / 180.f);
@@ -255,6 +259,48 @@ TEST(HemiField, LookupReturnsNearestAdmissibleAmongKNearest) {
             }
         }
         EXPECT_GT(found, 20);  // about 13% (knn 1) to 27% of random normals are admissible
+    }
+}
+
+// lookup=cell: the first admissible of the k points nearest to the centre of the query's cell,
+// whatever order the cells were filled in (and with knn above the memo's entry size, exact).
+TEST(HemiField, CellLookupTakesTheFirstAdmissibleNearTheCellCentre) {
+    for (int knn : {1, 8, 13, 20}) {
+        auto f = makeHemi(cornerScene(), {{"points", "2000"}, {"knn", std::to_string(knn)}});
+        ASSERT_TRUE(f);
+        const CellCache* cache = f->cellCache();
+        ASSERT_EQ(cache != nullptr, knn <= CellCache::kMaxCandidates);
+        const int points = f->numRegions() / 2;
+        const float cosMax = std::cos(30.f * 3.14159265f / 180.f);
+        std::mt19937_64 rng(23);
+        std::uniform_real_distribution<float> uni(0.f, 1.f);
+        int found = 0;
+        for (int q = 0; q < 600; ++q) {
+            // Half the queries repeat an earlier position, so they hit filled cells.
+            glm::vec3 p(uni(rng) * 0.2f, uni(rng), uni(rng) * 0.2f);
+            const glm::vec3 n = gaussianDirection(rng);
+            const glm::vec3 from = cache ? cache->centreOf(p) : p;
+            std::vector<std::pair<float, int>> byDist;
+            for (int i = 0; i < points; ++i) {
+                glm::vec3 d = f->regionPosition(2 * i) - from;
+                byDist.emplace_back(glm::dot(d, d), i);
+            }
+            std::sort(byDist.begin(), byDist.end());
+            int expected = -1;
+            for (int k = 0; k < knn && expected < 0; ++k) {
+                float c = glm::dot(n, f->regionNormal(2 * byDist[size_t(k)].second));
+                if (std::abs(c) >= cosMax)
+                    expected = 2 * byDist[size_t(k)].second + (c >= 0.f ? 0 : 1);
+            }
+            EXPECT_EQ(f->lookup(p, n), expected) << "knn " << knn << " query " << q;
+            EXPECT_EQ(f->lookup(p, n), expected) << "knn " << knn << " query " << q << " again";
+            found += expected >= 0;
+        }
+        EXPECT_GT(found, 20);
+        if (cache) {
+            EXPECT_GT(cache->size(), 10u);
+            EXPECT_LE(cache->size(), 600u);
+        }
     }
 }
 
