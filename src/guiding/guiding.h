@@ -120,7 +120,8 @@ public:
     virtual void recordSelection(int slot, int region, const SelectionSample& s);
 
     // Learning: during a pass, record that from `region` the direction w received target T
-    // (T = Le + scatteredEstimate at the next vertex, or the environment radiance). `slot` is
+    // (the radiance the direction brought back along the path, or Eq. 1's T = Le +
+    // scatteredEstimate at the next vertex, or the environment radiance). `slot` is
     // the caller's work-item index (film tile) in [0, numSlots): records are merged in slot
     // order at endPass() so results do not depend on thread scheduling. Thread-safe across
     // slots; one thread at a time per slot.
@@ -160,16 +161,21 @@ public:
 //   init         initial Q, positive and <= 3.4e38 (default 1e-3)
 //   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)
 //   knn          nearest points checked for an admissible normal, 1..64 (default 8)
+//   lookup       "cell" (default): the knn points nearest to the centre of the vertex's grid
+//                cell (cells of the points' mean spacing), memoised per cell; "exact": the
+//                knn points nearest to the vertex (kd-tree query per vertex)
 //   warmup       records per stratum until a region's policy gets the full mixture weight:
 //                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 16;
 //                0 = always full weight, the paper's behaviour)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
-//   mix, target, samples
+//   mix, target, samples, auto
 //                consumed by the integrator and the render loop; accepted and ignored here
-//                ("samples=independent": a sample set per pass; "mix=learn" makes
-//                the integrator record selection samples, from which every backend learns
-//                selection() per region)
+//                ("target=path|sample|sum": train on the path's returns, the default, or
+//                on Eq. 1's bootstrap; "samples=independent": a sample set per pass;
+//                "auto=N": the guided-or-plain trial; "mix=learn" makes the integrator
+//                record selection samples, from which every backend learns selection() per
+//                region)
 // Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.
 // Parameters alpha, strata, init, epsilon, cosine, max-mb, mix, target as hemi, and
 //   voxel        N: N voxels along the longest axis of the scene bounds, 1..4096

@@ -39,17 +39,23 @@ struct GuideSettings {
     // selection samples the integrator records); `mix` stays the value for regions without a
     // learned one.
     bool learnMix = false;
-    bool learn = true;  // record Eq. 1 targets during rendering
-    // How the sum of Eq. 1 is evaluated at a non-Lambertian vertex y: over all strata
+    bool learn = true;  // record training targets during rendering
+    // With Eq. 1's targets (target=sum|sample, pathTarget false): how the sum of Eq. 1 is
+    // evaluated at a non-Lambertian vertex y: over all strata
     // (n BSDF evaluations, the paper's form) or with the one direction sampled at y
     // (Q(y, w') f cos / pdf: an unbiased one-sample estimate of the same sum, no extra
     // evaluations). Lambertian vertices always use the exact sum (learned irradiance).
     bool sampledTarget = true;
-    // target=path: train on the radiance the rest of the path actually brought back to a
-    // guided vertex (a Monte Carlo return, as practical path guiding does) instead of
-    // bootstrapping Eq. 1 from Q at the next vertex: no propagation delay of one bounce per
-    // pass, noisier targets.
-    bool pathTarget = false;
+    // target=path: train each guided vertex on the radiance the rest of its path actually
+    // brought back through the sampled direction, as the estimator weighs it (a Monte Carlo
+    // return, as practical path guiding trains; emission hit by the direction carries its MIS
+    // weight against next-event estimation), instead of Eq. 1's bootstrap from Q at the next
+    // vertex. The guide then learns what direction sampling has to find, not light that
+    // next-event estimation already delivers. Measured at 64 spp, seeds 2/3, relMSE:
+    // cornell-box 0.000896/0.000891 (Eq. 1) -> 0.000744/0.000743, conference 0.000311/0.000318
+    // -> 0.000288/0.000292, breakfast 5.27/4.49 -> 4.10/3.97, veach-bidir 0.165/0.159 ->
+    // 0.170/0.163 (none: about 0.00090, 0.00029, 6 and 0.33).
+    bool pathTarget = true;
     // Where a guided render's passes take their samples (samples=sequence|independent):
     // from the one low-discrepancy sequence per pixel that plain rendering uses (false, the
     // default), or from an independently randomized set per pass (true). The sequence
@@ -64,12 +70,13 @@ struct GuideSettings {
     // render one plain pass as large as the guided pass before it, compare the two passes'
     // costs (relative variance per sample times CPU seconds per sample, render/efficiency.h)
     // and render the rest without guiding (no lookups, no learning) if the guided cost
-    // exceeds 1.15 times the plain one. 0 = always guide (the default here; the command line
-    // passes kCommandLineAutoSpp). Measured at N = 16, 96 spp, seeds 1/2/3 (guided/plain cost): killeroo
-    // 1.45/1.47/1.38, cornell-box 1.38/1.43/1.35, conference 1.23/1.27/1.24, veach-bidir
-    // 0.56/1.05/1.10, breakfast 0.62/3.24/0.45 (docs/BENCHMARKS.md).
+    // exceeds 1.15 times the plain one. 0 = always guide (the default). Measured with Eq. 1's
+    // targets at N = 16, 96 spp, seeds 1/2/3 (guided/plain cost): killeroo 1.45/1.47/1.38,
+    // cornell-box 1.38/1.43/1.35, conference 1.23/1.27/1.24, veach-bidir 0.56/1.05/1.10,
+    // breakfast 0.62/3.24/0.45. With the path targets the trial misjudges: it measured
+    // 0.74-1.05 on conference, killeroo, cornell-box and veach-mis, which lose 1.16-1.37x at
+    // 30 s, and 2.3 on breakfast, which wins 0.78x (docs/BENCHMARKS.md); not the default.
     int autoSpp = 0;
-    static constexpr int kCommandLineAutoSpp = 16;
 };
 
 class Rng;

@@ -150,14 +150,6 @@ int main(int argc, char** argv) {
     }
     if (guide == "none" && !guideParams.empty())
         std::fprintf(stderr, "warning: --guide-param is ignored with --guide=none\n");
-    // On the command line a guided render runs the guided-or-plain trial (at 16 spp) unless
-    // told otherwise (auto=0: always guide). At 30 s it took the equal-time relMSE ratio to
-    // none from 1.75 to 1.04-1.12 on cornell-box, 1.53 to 1.06 on killeroo, 1.43 to 1.00 on
-    // veach-mis, and kept guiding on veach-bidir (0.70-0.77); docs/BENCHMARKS.md. (The
-    // library's GuideSettings default is 0, so tests of the guided estimators guide
-    // throughout.)
-    if (guide != "none" && gc.params.find("auto") == gc.params.end())
-        gc.params["auto"] = std::to_string(GuideSettings::kCommandLineAutoSpp);
     std::unique_ptr<guiding::GuidingField> field;
     GuideSettings guideSettings;
     {

@@ -358,6 +358,8 @@ const Extreme kExtremes[] = {
     {"epsilon_0", {{"epsilon", "0"}, {"mix", "1"}, {"warmup", "0"}}},
     {"normal_angle_tiny", {{"normal-angle", "0.001"}}},
     {"target_sample", {{"target", "sample"}}},
+    {"target_sum", {{"target", "sum"}}},
+    {"target_path_mix_1", {{"target", "path"}, {"mix", "1"}, {"warmup", "0"}}},
     {"knn_1", {{"knn", "1"}}},
     {"mix_learn", {{"mix", "learn"}, {"warmup", "0"}}},
     {"samples_independent", {{"samples", "independent"}}},

@@ -1,0 +1,144 @@
+// What the integrator teaches a guiding field: with target=path (the default) each guided
+// vertex is trained on the radiance its sampled direction brought back as the estimator counts
+// it (emission with its MIS weight against next-event estimation, not the vertex's own NEE);
+// with Eq. 1's targets (target=sample) on the full emission. A recording field with a known
+// policy on a diffuse plane under a uniform sky makes both exact per record.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "guiding/guiding.h"
+#include "parser/diagnostics.h"
+#include "render/integrator.h"
+#include "render/sampler.h"
+#include "render/sampling.h"
+#include "render/scene.h"
+#include "render/scene_builder.h"
+
+namespace rlpbrt {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+// One region everywhere, uniform over the upper hemisphere (z > 0), recording every target.
+class RecordingField final : public guiding::GuidingField {
+public:
+    struct Record {
+        glm::vec3 w;
+        float target;
+    };
+    int lookup(const glm::vec3&, const glm::vec3& n) const override { return n.z > 0.f ? 0 : -1; }
+    glm::vec3 sample(int, glm::vec2 u, float, float* pdf) const override {
+        const float z = u.x, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * u.y;
+        *pdf = 1.f / (2.f * kPi);
+        return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
+    }
+    float pdf(int, const glm::vec3& w) const override {
+        return w.z > 0.f ? 1.f / (2.f * kPi) : 0.f;
+    }
+    float scatteredEstimate(int, const std::function<float(const glm::vec3&)>&) const override {
+        return 0.f;
+    }
+    float radiance(int, const glm::vec3&) const override { return 0.f; }
+    void beginPass(int) override {}
+    void record(int, int region, const glm::vec3& w, float target) override {
+        std::lock_guard<std::mutex> lock(mutex_);
+        EXPECT_EQ(region, 0);
+        records.push_back(Record{w, target});
+    }
+    void endPass() override {}
+    size_t bytes() const override { return 0; }
+    std::string describe() const override { return "recording"; }
+    guiding::GuidingStats stats() const override { return {}; }
+
+    std::vector<Record> records;
+
+private:
+    std::mutex mutex_;
+};
+
+// A large white-ish diffuse plane at z = 0 under a uniform sky of radiance 1; one bounce.
+const char* kPlane = R"(
+Film "image" "integer xresolution" [8] "integer yresolution" [8]
+Sampler "random" "integer pixelsamples" [1]
+Integrator "path" "integer maxdepth" [1]
+LookAt 0 0 1  0 0 0  0 1 0
+Camera "perspective" "float fov" [30]
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+Material "matte" "rgb Kd" [0.5 0.5 0.5]
+Shape "trianglemesh" "point P" [-100 -100 0  100 -100 0  100 100 0  -100 100 0]
+  "integer indices" [0 1 2  0 2 3]
+WorldEnd
+)";
+
+std::unique_ptr<Scene> buildPlane() {
+    Diagnostics diag;
+    diag.setStream(nullptr);
+    SceneBuilder builder(diag);
+    EXPECT_TRUE(parseString(kPlane, "plane.pbrt", builder, diag));
+    SceneDesc desc = builder.takeDesc();
+    auto scene = buildScene(desc, BuildOptions(), diag);
+    EXPECT_NE(scene, nullptr);
+    return scene;
+}
+
+// Renders 2000 paths straight down at the plane and returns the field's records.
+std::vector<RecordingField::Record> train(const Scene& scene, bool pathTarget) {
+    RecordingField field;
+    GuideSettings gs;
+    gs.field = &field;
+    gs.mix = 0.5f;
+    gs.pathTarget = pathTarget;
+    PathIntegrator integrator(scene, gs);
+    IndependentSampler sampler(1, 3);
+    PathStats stats;
+    field.beginPass(1);
+    for (int i = 0; i < 2000; ++i) {
+        sampler.startPixelSample(i % 40, i / 40, 0);
+        const Ray ray(Vec3(0.01f * float(i % 40) - 0.2f, 0.01f * float(i / 40) - 0.25f, 1.f),
+                      Vec3(0.f, 0.f, -1.f));
+        integrator.Li(ray, sampler, stats, 0);
+    }
+    field.endPass();
+    return field.records;
+}
+
+TEST(GuideTargets, PathTargetIsTheMisWeightedReturnOfTheDirection) {
+    auto scene = buildPlane();
+    ASSERT_TRUE(scene);
+    ASSERT_EQ(scene->lights.size(), 1u);
+    const Light& sky = *scene->lights[0];
+    const auto records = train(*scene, true);
+    ASSERT_GT(records.size(), 1900u);  // every path escapes from its one guided vertex
+    const float lumSky = luminance(Spectrum(1.f));
+    double meanTarget = 0.0;
+    for (const auto& r : records) {
+        ASSERT_GT(r.w.z, 0.f);
+        // The direction's mixture pdf: half the guide's uniform hemisphere, half Lambertian.
+        const float dirPdf = 0.5f / (2.f * kPi) + 0.5f * r.w.z / kPi;
+        const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
+        const float lightPdf = sky.pdfLi(ctx, r.w, Vec3(0.f), Vec3(0.f));
+        const float expected = lumSky * powerHeuristic(1, dirPdf, 1, lightPdf);
+        EXPECT_NEAR(r.target, expected, 2e-3f * expected + 1e-6f) << r.w.z;
+        meanTarget += r.target;
+    }
+    // Strictly less than the sky's radiance: next-event estimation delivers the rest.
+    meanTarget /= double(records.size());
+    EXPECT_GT(meanTarget, 0.2);
+    EXPECT_LT(meanTarget, 0.95 * lumSky);
+}
+
+TEST(GuideTargets, EquationOneTargetIsTheFullEmission) {
+    auto scene = buildPlane();
+    ASSERT_TRUE(scene);
+    const auto records = train(*scene, false);
+    ASSERT_GT(records.size(), 1900u);
+    for (const auto& r : records) EXPECT_NEAR(r.target, luminance(Spectrum(1.f)), 1e-5f);
+}
+
+}  // namespace
+}  // namespace rlpbrt
