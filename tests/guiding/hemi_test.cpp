@@ -221,12 +221,28 @@ TEST(HemiField, LookupOnPlaneSidesAndAngle) {
     EXPECT_EQ(f->lookup(p, glm::vec3(0.f)), -1);
 }
 
+// Brute force: the region of the first point, among the knn points nearest to `from`, whose
+// normal is within 30 degrees of +-n (the hemisphere on n's side), or -1.
+int firstAdmissibleNear(const HemiField& f, const glm::vec3& from, const glm::vec3& n, int knn) {
+    const float cosMax = std::cos(30.f * 3.14159265f / 180.f);
+    std::vector<std::pair<float, int>> byDist;
+    for (int i = 0; i < f.numRegions() / 2; ++i) {
+        const glm::vec3 d = f.regionPosition(2 * i) - from;
+        byDist.emplace_back(glm::dot(d, d), i);
+    }
+    std::sort(byDist.begin(), byDist.end());
+    for (int k = 0; k < knn && k < int(byDist.size()); ++k) {
+        const float c = glm::dot(n, f.regionNormal(2 * byDist[size_t(k)].second));
+        if (std::abs(c) >= cosMax) return 2 * byDist[size_t(k)].second + (c >= 0.f ? 0 : 1);
+    }
+    return -1;
+}
+
 TEST(HemiField, LookupReturnsNearestAdmissibleAmongKNearest) {
     for (int knn : {1, 8, 64}) {
         auto f = makeHemi(cornerScene(), {{"points", "2000"}, {"knn", std::to_string(knn)},
                                           {"lookup", "exact"}});
         ASSERT_TRUE(f);
-        const int points = f->numRegions() / 2;
         const float cosMax = std::cos(30.f * 3.14159265f / 180.f);
         std::mt19937_64 rng(17);
         std::uniform_real_distribution<float> uni(0.f, 1.f);
@@ -234,22 +250,7 @@ TEST(HemiField, LookupReturnsNearestAdmissibleAmongKNearest) {
         for (int q = 0; q < 500; ++q) {
             glm::vec3 p(uni(rng) * 0.2f, uni(rng), uni(rng) * 0.2f);  // near the corner
             glm::vec3 n = gaussianDirection(rng);
-            // Brute force: sort points by distance, take the first admissible of the k nearest.
-            std::vector<std::pair<float, int>> byDist;
-            for (int i = 0; i < points; ++i) {
-                glm::vec3 d = f->regionPosition(2 * i) - p;
-                byDist.emplace_back(glm::dot(d, d), i);
-            }
-            std::sort(byDist.begin(), byDist.end());
-            int expected = -1;
-            for (int k = 0; k < knn; ++k) {
-                glm::vec3 pn = f->regionNormal(2 * byDist[size_t(k)].second);
-                float c = glm::dot(n, pn);
-                if (std::abs(c) >= cosMax) {
-                    expected = 2 * byDist[size_t(k)].second + (c >= 0.f ? 0 : 1);
-                    break;
-                }
-            }
+            const int expected = firstAdmissibleNear(*f, p, n, knn);
             int got = f->lookup(p, n);
             EXPECT_EQ(got, expected) << "knn " << knn << " query " << q;
             if (got >= 0) {
@@ -270,28 +271,15 @@ TEST(HemiField, CellLookupTakesTheFirstAdmissibleNearTheCellCentre) {
         ASSERT_TRUE(f);
         const CellCache* cache = f->cellCache();
         ASSERT_EQ(cache != nullptr, knn <= CellCache::kMaxCandidates);
-        const int points = f->numRegions() / 2;
-        const float cosMax = std::cos(30.f * 3.14159265f / 180.f);
         std::mt19937_64 rng(23);
         std::uniform_real_distribution<float> uni(0.f, 1.f);
         int found = 0;
         for (int q = 0; q < 600; ++q) {
-            // Half the queries repeat an earlier position, so they hit filled cells.
+            // Each query twice: the first may fill its cell, the second reads the memo.
             glm::vec3 p(uni(rng) * 0.2f, uni(rng), uni(rng) * 0.2f);
             const glm::vec3 n = gaussianDirection(rng);
-            const glm::vec3 from = cache ? cache->centreOf(p) : p;
-            std::vector<std::pair<float, int>> byDist;
-            for (int i = 0; i < points; ++i) {
-                glm::vec3 d = f->regionPosition(2 * i) - from;
-                byDist.emplace_back(glm::dot(d, d), i);
-            }
-            std::sort(byDist.begin(), byDist.end());
-            int expected = -1;
-            for (int k = 0; k < knn && expected < 0; ++k) {
-                float c = glm::dot(n, f->regionNormal(2 * byDist[size_t(k)].second));
-                if (std::abs(c) >= cosMax)
-                    expected = 2 * byDist[size_t(k)].second + (c >= 0.f ? 0 : 1);
-            }
+            const int expected =
+                firstAdmissibleNear(*f, cache ? cache->centreOf(p) : p, n, knn);
             EXPECT_EQ(f->lookup(p, n), expected) << "knn " << knn << " query " << q;
             EXPECT_EQ(f->lookup(p, n), expected) << "knn " << knn << " query " << q << " again";
             found += expected >= 0;
