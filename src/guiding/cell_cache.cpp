@@ -5,8 +5,8 @@
 namespace rlpbrt::guiding {
 
 CellCache::CellCache(const glm::vec3& boundsMin, const glm::vec3& boundsMax, float cellSize,
-                     size_t capacity, int k)
-    : origin_(boundsMin), k_(std::clamp(k, 1, kMaxCandidates)) {
+                     size_t capacity)
+    : origin_(boundsMin) {
     const glm::vec3 extent = glm::max(boundsMax - boundsMin, glm::vec3(0.f));
     const float longest = std::max({extent.x, extent.y, extent.z});
     const float minCell = longest / float((1 << kAxisBits) - 1);

@@ -26,15 +26,15 @@ public:
 
     // Cells of edge `cellSize` (grown if needed so the bounds fit in 2^21 cells per axis)
     // from boundsMin; a table of at least `capacity` entries (a power of two), each holding up
-    // to k candidates (k is clamped to 1..kMaxCandidates).
+    // to kMaxCandidates candidates.
     CellCache(const glm::vec3& boundsMin, const glm::vec3& boundsMax, float cellSize,
-              size_t capacity, int k);
+              size_t capacity);
 
     // The candidate list of p's cell: *out points to the candidates, the return value is
-    // their number. fill(centre, uint32_t* dest) must write at most k candidates for a query
-    // at the cell centre and return their number; it must be a pure function of the centre
-    // and thread-safe. `scratch` (k entries) receives the list when it is not cached. p must be
-    // finite.
+    // their number. fill(centre, uint32_t* dest) must write at most kMaxCandidates candidates
+    // for a query at the cell centre and return their number; it must be a pure function of
+    // the centre and thread-safe. `scratch` (as many entries) receives the list when it is not
+    // cached. p must be finite.
     template <class Fill>
     int candidates(const glm::vec3& p, Fill&& fill, uint32_t* scratch,
                    const uint32_t** out) const;
@@ -47,7 +47,6 @@ public:
     }
     float cellSize() const { return cell_; }
     size_t capacity() const { return mask_ + 1; }
-    int k() const { return k_; }
     // Entries filled so far.
     size_t size() const { return used_.load(std::memory_order_relaxed); }
     size_t bytes() const { return capacity() * sizeof(Entry); }
@@ -73,7 +72,6 @@ private:
 
     glm::vec3 origin_;
     float cell_, invCell_;
-    int k_;
     size_t mask_;
     std::unique_ptr<Entry[]> entries_;
     mutable std::atomic<size_t> used_{0};

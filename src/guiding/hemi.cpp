@@ -76,7 +76,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         const double spacing =
             std::sqrt(std::max(scene.totalArea, 0.0) / double(positions_.size()));
         cache_ = std::make_unique<CellCache>(scene.boundsMin, scene.boundsMax, float(spacing),
-                                             positions_.size() * 8, params_.knn);
+                                             positions_.size() * 8);
     }
 
     const size_t regions = positions_.size() * 2;

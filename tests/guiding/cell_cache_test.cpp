@@ -25,7 +25,7 @@ int listOf(const glm::vec3& c, int k, uint32_t* dest) {
 }
 
 TEST(CellCache, OneEvaluationPerCellAndTheCellCentre) {
-    CellCache cache(glm::vec3(-1.f), glm::vec3(1.f), 0.25f, 4096, 8);
+    CellCache cache(glm::vec3(-1.f), glm::vec3(1.f), 0.25f, 4096);
     EXPECT_FLOAT_EQ(cache.cellSize(), 0.25f);
     EXPECT_EQ(cache.capacity(), 4096u);
     std::mt19937 rng(5);
@@ -59,7 +59,7 @@ TEST(CellCache, OneEvaluationPerCellAndTheCellCentre) {
 
 TEST(CellCache, ConcurrentFillingGivesTheDirectLists) {
     // 8000 cells in 65536 entries: no probe sequence reaches kMaxProbes, every cell is cached.
-    CellCache cache(glm::vec3(0.f), glm::vec3(10.f), 0.5f, 65536, 13);
+    CellCache cache(glm::vec3(0.f), glm::vec3(10.f), 0.5f, 65536);
     std::vector<glm::vec3> queries(200000);
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> uni(0.f, 10.f);
@@ -82,7 +82,7 @@ TEST(CellCache, ConcurrentFillingGivesTheDirectLists) {
 
 TEST(CellCache, AFullTableEvaluatesDirectly) {
     // 4096 cells, 1024 entries: at most 768 are cached, the rest are evaluated each time.
-    CellCache cache(glm::vec3(0.f), glm::vec3(16.f), 1.f, 1000, 4);
+    CellCache cache(glm::vec3(0.f), glm::vec3(16.f), 1.f, 1000);
     EXPECT_EQ(cache.capacity(), 1024u);
     int fills = 0;
     for (int round = 0; round < 2; ++round)
@@ -109,13 +109,13 @@ TEST(CellCache, AFullTableEvaluatesDirectly) {
 TEST(CellCache, HugeBoundsGrowTheCells) {
     // 2^21 cells per axis at most: a tiny cell over huge bounds is enlarged, and points outside
     // the bounds fall in the border cells.
-    CellCache cache(glm::vec3(-1e6f), glm::vec3(1e6f), 1e-3f, 1024, 1);
+    CellCache cache(glm::vec3(-1e6f), glm::vec3(1e6f), 1e-3f, 1024);
     EXPECT_GE(cache.cellSize(), 2e6f / float(1 << 21));
     const glm::vec3 c = cache.centreOf(glm::vec3(-5e6f, 0.f, 5e6f));
     EXPECT_LT(c.x, -1e6f + cache.cellSize());
     EXPECT_GT(c.z, 1e6f - cache.cellSize());
     // Degenerate bounds and cell size still give a usable grid.
-    CellCache flat(glm::vec3(0.f), glm::vec3(0.f), 0.f, 16, 2);
+    CellCache flat(glm::vec3(0.f), glm::vec3(0.f), 0.f, 16);
     EXPECT_GT(flat.cellSize(), 0.f);
     EXPECT_TRUE(std::isfinite(flat.centreOf(glm::vec3(3.f)).x));
 }
