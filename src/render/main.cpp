@@ -85,9 +85,12 @@ int main(int argc, char** argv) {
     app.add_option("--guide", guide, "guiding backend: none, hemi or vdb")
         ->check(CLI::IsMember({"none", "hemi", "vdb"}));
     app.add_option("--guide-param", guideParams,
-                   "guiding parameter key=value (repeatable): mix, alpha, strata (WxH), "
-                   "points, normal-angle, init, epsilon, knn, auto (default 16; 0 = always "
-                   "guide); vdb: voxel, voxel-size, dirs");
+                   "guiding parameter key=value (repeatable): mix (0..1 or learn), alpha, "
+                   "strata (WxH), points, normal-angle, init, epsilon, cosine, max-mb, "
+                   "target (path, sample or sum), samples, auto (N spp: a guided-or-plain "
+                   "trial; default off); hemi: knn, warmup, lookup (cell or exact); vdb: "
+                   "voxel, voxel-size, dirs, normals, warmup, volume, volume-voxel "
+                   "(README.md)");
     app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering");
     app.add_option("--guide-load", guideLoad,
                    "start from a guiding field saved for this scene with the same backend");
