@@ -5,7 +5,9 @@
 # reference, so one run gives relMSE at every pass (the whole ladder of time budgets). The
 # configurations of one scene run at the same time, one thread each, so that they share
 # whatever else the machine is doing; compare them with each other, not across scenes run
-# at different times. Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
+# at different times. SEQUENTIAL=1 instead renders the configurations of a scene one after
+# another, each with every core (--nthreads 0): a user's render, each alone on the machine
+# (its caches and memory bandwidth unshared). Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
 # commas for spaces), default none, hemi, vdb and one variation of each main parameter.
 # Writes OUTDIR/<scene>__<config>.{csv,json,exr}; bench/curves_report.py summarises them.
 set -euo pipefail
@@ -25,11 +27,15 @@ default="$default vdb-voxel32=--guide,vdb,--guide-param,voxel=32"
 default="$default hemi-mix0.25=--guide,hemi,--guide-param,mix=0.25"
 default="$default hemi-mix0.75=--guide,hemi,--guide-param,mix=0.75"
 configs=${CONFIGS:-$default}
+sequential=${SEQUENTIAL:-0}
+threads=1
+[ "$sequential" = 1 ] && threads=0
 {
     echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
     echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
     echo "seconds: $secs"
     echo "configs: $configs"
+    echo "sequential: $sequential (threads per render: $threads, 0 = all)"
     echo "commit: $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)"
 } > "$out/run.txt"
 
@@ -40,12 +46,16 @@ tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene 
         name=${cfg%%=*}
         args=${cfg#*=}
         # shellcheck disable=SC2086
-        "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads 1 --quiet ${args//,/ } \
+        "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads "$threads" --quiet ${args//,/ } \
             --ref "$shared/references/$id.exr" --curve "$out/${id}__$name.csv" \
             --stats "$out/${id}__$name.json" -o "$out/${id}__$name.exr" \
             > /dev/null 2> "$out/${id}__$name.log" &
-        pids+=($!)
+        if [ "$sequential" = 1 ]; then
+            wait "$!" || echo "warning: $id $name failed (see $out/${id}__$name.log)" >&2
+        else
+            pids+=($!)
+        fi
     done
-    for p in "${pids[@]}"; do wait "$p" || echo "warning: a run of $id failed (see $out/${id}__*.log)" >&2; done
+    for p in "${pids[@]+"${pids[@]}"}"; do wait "$p" || echo "warning: a run of $id failed (see $out/${id}__*.log)" >&2; done
     echo "$id done" >&2
 done

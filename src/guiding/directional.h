@@ -97,12 +97,14 @@ public:
             // cols_ divides 8: the column from the octant of (x, y), by comparisons only.
             const float x = local.x, y = local.y;
             if (!(x == x) || !(y == y)) return -1;  // NaN components
-            int octant;
-            if (y >= 0.f)
-                octant = x >= 0.f ? (y < x || y == 0.f ? 0 : 1) : (-x < y ? 2 : 3);
-            else
-                octant = x < 0.f ? (-x > -y ? 4 : 5) : (x < -y ? 6 : 7);
-            col = octant >> octantShift_;
+            // Quadrant q (counter-clockwise from +x), then the half of it: branch-free, as the
+            // octant of a scattered direction is unpredictable. Directions on an edge go
+            // where the earlier branching code put them (tests/guiding/directional_test.cpp).
+            const int ny = y < 0.f, nx = x < 0.f;
+            const int q = (ny << 1) | (nx ^ ny);
+            const float ax = std::abs(x), ay = std::abs(y);
+            const int half = (q & 1) ? int(ax >= ay) : int(ay >= ax) & int(ay > 0.f);
+            col = (q * 2 + half) >> octantShift_;
         } else if (cols_ > 1) {
             float phi = azimuth(local.x, local.y);
             if (!(phi >= 0.f)) return -1;  // NaN components

@@ -272,6 +272,11 @@ std::string HemiField::describe() const {
                   (unsigned long long)stats().rejectedTargets,
                   (unsigned long long)stats().rejectedRecords);
     std::string line = buf;
+    if (cache_) {
+        std::snprintf(buf, sizeof(buf), "; lookup memo: %zu of %zu cells filled",
+                      cache_->size(), cache_->capacity());
+        line += buf;
+    }
     const SelectionLearner& sel = table_.selection();
     if (sel.learnedRegions() > 0) {
         std::snprintf(buf, sizeof(buf), "; learned selection in %zu regions, mean %.3f",

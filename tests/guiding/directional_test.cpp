@@ -56,6 +56,38 @@ TEST(StrataLayout, IndexEdgesClamp) {
     EXPECT_EQ(one.stratumOf(glm::vec3(-1, -1e-30f, 1e-6f)), 0);
 }
 
+TEST(StrataLayout, OctantColumnsMatchTheAzimuth) {
+    // Column counts dividing 8 take the column from comparisons (branch-free octants); it
+    // must be the azimuth's column for every direction off the octant edges.
+    std::mt19937_64 rng(5);
+    for (int cols : {1, 2, 4, 8}) {
+        StrataLayout layout(cols, 3);
+        int checked = 0;
+        for (int i = 0; i < 20000; ++i) {
+            glm::vec3 w = gaussianDirection(rng);
+            w.z = std::abs(w.z);
+            const int j = layout.stratumOf(w);
+            ASSERT_GE(j, 0);
+            const double phi = std::atan2(double(w.y), double(w.x));
+            const double turns = (phi < 0.0 ? phi + 2.0 * kPi : phi) / (2.0 * kPi) * cols;
+            if (std::abs(turns - std::round(turns)) < 1e-5) continue;  // on an edge
+            ASSERT_EQ(j % cols, int(turns)) << cols << " cols, w = " << w.x << " " << w.y;
+            ++checked;
+        }
+        EXPECT_GT(checked, 19900);
+    }
+    // Directions on octant edges (measure zero) are pinned: saved guides keep their strata.
+    StrataLayout layout(8, 1);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(1, 1, 1)), 1);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, 1, 1)), 1);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(-1, 1, 1)), 3);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(-1, 0, 1)), 3);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(-1, -1, 1)), 5);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, -1, 1)), 6);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(1, -1, 1)), 7);
+    EXPECT_EQ(layout.stratumOf(glm::vec3(0, 0, 1)), 0);
+}
+
 TEST(StrataLayout, StrataHaveEqualSolidAngle) {
     // Uniform sphere directions (Gaussian construction) must fill the 8x6 strata equally.
     StrataLayout layout(8, 6);
