@@ -39,6 +39,11 @@ public:
     int candidates(const glm::vec3& p, Fill&& fill, uint32_t* scratch,
                    const uint32_t** out) const;
 
+    // Starts loading the first entry p's cell probes (p finite).
+    void prefetch(const glm::vec3& p) const {
+        glm::vec3 c;
+        __builtin_prefetch(&entries_[size_t(mix(keyOf(p, &c) + 1)) & mask_]);
+    }
     // The centre of p's cell (where the candidates of p were computed).
     glm::vec3 centreOf(const glm::vec3& p) const {
         glm::vec3 c;

@@ -22,6 +22,7 @@ float GuidingField::selection(int) const { return -1.f; }
 void GuidingField::recordSelection(int, int, const SelectionSample&) {}
 
 int GuidingField::lookupMedium(const glm::vec3&) const { return -1; }
+void GuidingField::prefetch(const glm::vec3&) const {}
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
 

@@ -75,6 +75,9 @@ public:
     // Region for a vertex at p whose hemisphere of interest is around unit normal n (the
     // integrator passes the shading normal flipped to wo's side). -1 = no data: use the BSDF.
     virtual int lookup(const glm::vec3& p, const glm::vec3& n) const = 0;
+    // A hint that lookup(p, ...) follows soon: a backend may start loading what it will read
+    // (no effect on results). Default: nothing.
+    virtual void prefetch(const glm::vec3& p) const;
     // Region for a scattering vertex at p inside a participating medium, whose directions
     // cover the whole sphere; -1 = no data there (sample the phase function). All the
     // per-region calls below accept it. Default: -1 (the backend guides on surfaces only).

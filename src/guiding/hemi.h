@@ -5,6 +5,7 @@
 // sampling CDFs are rebuilt between passes.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -68,6 +69,10 @@ public:
     HemiField& operator=(const HemiField&) = delete;
 
     int lookup(const glm::vec3& p, const glm::vec3& n) const override;
+    void prefetch(const glm::vec3& p) const override {
+        if (cache_ && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
+            cache_->prefetch(p);
+    }
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const override;
     float pdf(int region, const glm::vec3& w) const override;
     float scatteredEstimate(int region,

@@ -394,6 +394,9 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         SurfaceInteraction si;
         ++stats.rays;
         bool found = scene_.intersect(ray, &si);
+        // The lookup below reads a table entry for si.p: start loading it (a cache miss
+        // otherwise; the material evaluation runs in between).
+        if (found && field) field->prefetch(si.p);
         if (media && pm.medium >= 0) {
             // Free flight to the surface (or to infinity) through the current medium.
             const Medium& medium = *scene_.media[size_t(pm.medium)];
