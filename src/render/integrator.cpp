@@ -396,7 +396,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         bool found = scene_.intersect(ray, &si);
         // The lookup below reads a table entry for si.p: start loading it (a cache miss
         // otherwise; the material evaluation runs in between).
-        if (found && field) field->prefetch(si.p);
+        if (found && field && (bounces + 1 < maxDepth_ || bootstrap)) field->prefetch(si.p);
         if (media && pm.medium >= 0) {
             // Free flight to the surface (or to infinity) through the current medium.
             const Medium& medium = *scene_.media[size_t(pm.medium)];
@@ -500,14 +500,21 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         bsdf.clear();
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
         const bool canGuide = field && guidable(bsdf);
+        // The path's last direction (no vertex after it) brings back only the emission it
+        // hits, weighted against this vertex's next-event estimation: the learned Q, the light
+        // of whole returns, overstates what it can find there, and its truncated return would
+        // understate Q for the vertices before the last. It samples the BSDF and records no
+        // return (Eq. 1 targets, bootstrapped from Q, are learned there as everywhere).
+        const bool lastDirection = bounces + 1 >= maxDepth_;
         int region = -1;
-        if (canGuide) {
+        if (canGuide && (!lastDirection || bootstrap)) {
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
             region = field->lookup(si.p, nFacing);
         }
         const bool lastVertex = bounces >= maxDepth_;
         // The guide's probability here: mix x the region's confidence x the diffuse share.
-        const float share = region >= 0 && guide_.mix > 0.f ? diffuseShare(bsdf) : 0.f;
+        const float share =
+            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(bsdf) : 0.f;
         const int sampleRegion = share > 0.f ? region : -1;
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
@@ -548,7 +555,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         beta *= weight;
         dirPdf = ds.pdf;
         specularBounce = ds.specular;
-        pushReturn(ds.transmission ? -1 : region, ds.wi);
+        pushReturn(ds.transmission || lastDirection ? -1 : region, ds.wi);
         if (learn) {
             if (bootstrap && region >= 0 && !ds.transmission) {
                 pending = PendingRecord();

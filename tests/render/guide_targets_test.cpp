@@ -5,7 +5,9 @@
 // policy on a diffuse plane under a uniform sky makes both exact per record.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -23,15 +25,20 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-// One region everywhere, uniform over the upper hemisphere (z > 0), recording every target.
+// One region everywhere, uniform over the upper hemisphere (z > 0), recording every target
+// and counting its lookups and samples.
 class RecordingField final : public guiding::GuidingField {
 public:
     struct Record {
         glm::vec3 w;
         float target;
     };
-    int lookup(const glm::vec3&, const glm::vec3& n) const override { return n.z > 0.f ? 0 : -1; }
+    int lookup(const glm::vec3&, const glm::vec3& n) const override {
+        ++lookups;
+        return n.z > 0.f ? 0 : -1;
+    }
     glm::vec3 sample(int, glm::vec2 u, float, float* pdf) const override {
+        ++samples;
         const float z = u.x, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * u.y;
         *pdf = 1.f / (2.f * kPi);
         return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
@@ -55,16 +62,18 @@ public:
     guiding::GuidingStats stats() const override { return {}; }
 
     std::vector<Record> records;
+    mutable std::atomic<int> lookups{0}, samples{0};
 
 private:
     std::mutex mutex_;
 };
 
-// A large white-ish diffuse plane at z = 0 under a uniform sky of radiance 1; one bounce.
+// A large white-ish diffuse plane at z = 0 under a uniform sky of radiance 1; maxdepth given
+// (by default 2: the plane's vertex does not sample the path's last direction).
 const char* kPlane = R"(
 Film "image" "integer xresolution" [8] "integer yresolution" [8]
 Sampler "random" "integer pixelsamples" [1]
-Integrator "path" "integer maxdepth" [1]
+Integrator "path" "integer maxdepth" [%d]
 LookAt 0 0 1  0 0 0  0 1 0
 Camera "perspective" "float fov" [30]
 WorldBegin
@@ -75,20 +84,24 @@ Shape "trianglemesh" "point P" [-100 -100 0  100 -100 0  100 100 0  -100 100 0]
 WorldEnd
 )";
 
-std::unique_ptr<Scene> buildPlane() {
+std::unique_ptr<Scene> buildPlane(int maxDepth = 2) {
     Diagnostics diag;
     diag.setStream(nullptr);
     SceneBuilder builder(diag);
-    EXPECT_TRUE(parseString(kPlane, "plane.pbrt", builder, diag));
+    char text[1024];
+    std::snprintf(text, sizeof(text), kPlane, maxDepth);
+    EXPECT_TRUE(parseString(text, "plane.pbrt", builder, diag));
     SceneDesc desc = builder.takeDesc();
     auto scene = buildScene(desc, BuildOptions(), diag);
     EXPECT_NE(scene, nullptr);
     return scene;
 }
 
-// Renders 2000 paths straight down at the plane and returns the field's records.
-std::vector<RecordingField::Record> train(const Scene& scene, bool pathTarget) {
-    RecordingField field;
+// Renders 2000 paths straight down at the plane into `field`; returns its records.
+std::vector<RecordingField::Record> train(const Scene& scene, bool pathTarget,
+                                          RecordingField* into = nullptr) {
+    RecordingField local;
+    RecordingField& field = into ? *into : local;
     GuideSettings gs;
     gs.field = &field;
     gs.mix = 0.5f;
@@ -138,6 +151,29 @@ TEST(GuideTargets, EquationOneTargetIsTheFullEmission) {
     const auto records = train(*scene, false);
     ASSERT_GT(records.size(), 1900u);
     for (const auto& r : records) EXPECT_NEAR(r.target, luminance(Spectrum(1.f)), 1e-5f);
+}
+
+// The path's last direction (here the only one, maxdepth 1) brings back only emission that
+// next-event estimation also samples: it is drawn from the BSDF, and with path targets it
+// neither looks up a region nor records a return; Eq. 1 targets are still learned there.
+TEST(GuideTargets, TheLastDirectionIsNotGuided) {
+    auto one = buildPlane(1);
+    ASSERT_TRUE(one);
+    RecordingField returns;
+    EXPECT_TRUE(train(*one, true, &returns).empty());
+    EXPECT_EQ(returns.lookups.load(), 0);
+    EXPECT_EQ(returns.samples.load(), 0);
+    RecordingField eq1;
+    EXPECT_GT(train(*one, false, &eq1).size(), 1900u);
+    EXPECT_GT(eq1.lookups.load(), 1900);
+    EXPECT_EQ(eq1.samples.load(), 0);
+    // With one more bounce allowed the plane's vertex is guided: about half its directions
+    // (mix 0.5) come from the field (binomial, n = 2000: sd 22).
+    auto two = buildPlane(2);
+    ASSERT_TRUE(two);
+    RecordingField guided;
+    EXPECT_GT(train(*two, true, &guided).size(), 1900u);
+    EXPECT_NEAR(guided.samples.load(), 1000, 120);
 }
 
 }  // namespace
