@@ -20,16 +20,4 @@ CellCache::CellCache(const glm::vec3& boundsMin, const glm::vec3& boundsMax, flo
     entries_ = std::make_unique<Entry[]>(cap);
 }
 
-uint64_t CellCache::keyOf(const glm::vec3& p, glm::vec3* centre) const {
-    constexpr int64_t maxCell = (int64_t(1) << kAxisBits) - 1;
-    uint64_t key = 0;
-    for (int a = 0; a < 3; ++a) {
-        const float f = std::floor((p[a] - origin_[a]) * invCell_);
-        const int64_t c = f <= 0.f ? 0 : f >= float(maxCell) ? maxCell : int64_t(f);
-        (*centre)[a] = origin_[a] + (float(c) + 0.5f) * cell_;
-        key |= uint64_t(c) << (a * kAxisBits);
-    }
-    return key;
-}
-
 }  // namespace rlpbrt::guiding

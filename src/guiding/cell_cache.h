@@ -58,7 +58,7 @@ public:
 
 private:
     static constexpr uint32_t kUnset = UINT32_MAX;
-    uint64_t keyOf(const glm::vec3& p, glm::vec3* centre) const;
+    uint64_t keyOf(const glm::vec3& p, glm::vec3* centre) const;  // (inline below)
     // A 64-bit finaliser (every key bit reaches the low bits the table indexes with).
     static uint64_t mix(uint64_t x) {
         x ^= x >> 30;
@@ -81,6 +81,20 @@ private:
     std::unique_ptr<Entry[]> entries_;
     mutable std::atomic<size_t> used_{0};
 };
+
+inline uint64_t CellCache::keyOf(const glm::vec3& p, glm::vec3* centre) const {
+    constexpr int64_t maxCell = (int64_t(1) << kAxisBits) - 1;
+    uint64_t key = 0;
+    for (int a = 0; a < 3; ++a) {
+        // Truncation is the floor here: negative offsets clamp to cell 0 (no libm call; the
+        // baseline x86-64 target has no inline floor).
+        const float f = (p[a] - origin_[a]) * invCell_;
+        const int64_t c = f <= 0.f ? 0 : f >= float(maxCell) ? maxCell : int64_t(f);
+        (*centre)[a] = origin_[a] + (float(c) + 0.5f) * cell_;
+        key |= uint64_t(c) << (a * kAxisBits);
+    }
+    return key;
+}
 
 template <class Fill>
 int CellCache::candidates(const glm::vec3& p, Fill&& fill, uint32_t* scratch,
