@@ -7,7 +7,9 @@
 # whatever else the machine is doing; compare them with each other, not across scenes run
 # at different times. SEQUENTIAL=1 instead renders the configurations of a scene one after
 # another, each with every core (--nthreads 0): a user's render, each alone on the machine
-# (its caches and memory bandwidth unshared). Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
+# (its caches and memory bandwidth unshared). PIN=1 pins the k-th configuration to core
+# k mod nproc (a VM's cores can run at different speeds: run twice with the order reversed
+# and compare both). Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
 # commas for spaces), default none, hemi, vdb and one variation of each main parameter.
 # Writes OUTDIR/<scene>__<config>.{csv,json,exr}; bench/curves_report.py summarises them.
 set -euo pipefail
@@ -35,18 +37,22 @@ threads=1
     echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
     echo "seconds: $secs"
     echo "configs: $configs"
-    echo "sequential: $sequential (threads per render: $threads, 0 = all)"
+    echo "sequential: $sequential (threads per render: $threads, 0 = all); pinned: ${PIN:-0}"
     echo "commit: $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)"
 } > "$out/run.txt"
 
 tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media; do
     [ $# -gt 0 ] && [[ "$want" != *" $id "* ]] && continue
     pids=()
+    k=0
     for cfg in $configs; do
         name=${cfg%%=*}
         args=${cfg#*=}
         # shellcheck disable=SC2086
-        "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads "$threads" --quiet ${args//,/ } \
+        pin=()
+        [ "${PIN:-0}" = 1 ] && pin=(taskset -c $((k % $(nproc))))
+        k=$((k + 1))
+        "${pin[@]}" "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads "$threads" --quiet ${args//,/ } \
             --ref "$shared/references/$id.exr" --curve "$out/${id}__$name.csv" \
             --stats "$out/${id}__$name.json" -o "$out/${id}__$name.exr" \
             > /dev/null 2> "$out/${id}__$name.log" &
