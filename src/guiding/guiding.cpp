@@ -131,7 +131,8 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
     } else if (key == "max-mb") {
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
         *maxMiB = d;
-    } else if (key == "mix" || key == "target" || key == "samples" || key == "auto") {
+    } else if (key == "mix" || key == "target" || key == "samples" || key == "auto" ||
+               key == "rr") {
         // Consumed by the integrator and the render loop.
     } else {
         return 0;
@@ -163,7 +164,7 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, warmup, lookup, max-mb, mix, target, samples, auto)";
+                     "cosine, warmup, lookup, max-mb, mix, target, samples, auto, rr)";
             return false;
         }
     }
@@ -214,7 +215,7 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             *error = "guiding backend 'vdb': unknown parameter '" + key +
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
                      "normal-angle, init, epsilon, cosine, warmup, volume, volume-voxel, "
-                     "max-mb, mix, target)";
+                     "max-mb, mix, target, samples, auto, rr)";
             return false;
         }
     }

@@ -92,6 +92,47 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     std::vector<std::unique_ptr<FilmTile>> tileFilms(tiles.size());
     for (size_t i = 0; i < tiles.size(); ++i) tileFilms[i] = film.makeTile(tiles[i]);
 
+    // Adjoint-driven roulette's pixel estimates (PathIntegrator::wantsPixelEstimate): the
+    // luminance of the image so far, averaged over 3x3 pixels (fewer outliers), in the
+    // radiance units of Li (without the film's scale); refreshed after every guided pass.
+    const Bounds2i estBounds = film.pixelBounds();
+    std::vector<float> pixelEstimate;
+    auto refreshEstimates = [&] {
+        const Image img = film.toImage();
+        const int w = img.width, h = img.height;
+        const float scale = film.params().scale;
+        if (w <= 0 || h <= 0 || !(scale > 0.f)) return;
+        std::vector<float> lum(size_t(w) * size_t(h));
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                lum[size_t(y) * w + x] =
+                    std::max(0.f, luminance(Spectrum(img.at(x, y, 0), img.at(x, y, 1),
+                                                     img.at(x, y, 2)))) / scale;
+        pixelEstimate.assign(lum.size(), 0.f);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                float sum = 0.f;
+                int n = 0;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int xx = x + dx, yy = y + dy;
+                        if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                        sum += lum[size_t(yy) * w + xx];
+                        ++n;
+                    }
+                const float e = sum / float(n);
+                pixelEstimate[size_t(y) * w + x] = std::isfinite(e) ? e : 0.f;
+            }
+    };
+    auto estimateAt = [&](int x, int y) {
+        if (pixelEstimate.empty()) return 0.f;
+        const int w = estBounds.pMax.x - estBounds.pMin.x;
+        const int h = estBounds.pMax.y - estBounds.pMin.y;
+        const int xx = std::clamp(x - estBounds.pMin.x, 0, w - 1);
+        const int yy = std::clamp(y - estBounds.pMin.y, 0, h - 1);
+        return pixelEstimate[size_t(yy) * w + xx];
+    };
+
     double start = now();
     long long samplesDone = 0;
     long long pixelsPerPass = 0;
@@ -151,6 +192,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 for (int y = b.pMin.y; y < b.pMax.y; ++y)
                     for (int x = b.pMin.x; x < b.pMax.x; ++x) {
                         PixelMoments pixel;
+                        const float estimate = estimateAt(x, y);
                         PassMoments* const into = moments ? moments : history.get();
                         const bool measured = into && into->tracked(x, y);
                         for (int s = first; s < first + count; ++s) {
@@ -160,7 +202,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                             CameraRay cr = scene.camera->generateRay(pFilm, uLens);
                             Spectrum L(0.f);
                             if (cr.weight > 0.f)
-                                L = passIntegrator.Li(cr.ray, sampler, st, int(ti));
+                                L = passIntegrator.Li(cr.ray, sampler, st, int(ti),
+                                                      estimate);
                             ++st.paths;
                             if (!isFinite(L)) {
                                 ++st.nonFinite;
@@ -208,6 +251,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         }
         film.mergeTiles(tileFilms);
         for (auto& t : tileFilms) t->clear();
+        if (guidedPass && passIntegrator.wantsPixelEstimate()) refreshEstimates();
         result.spp += count;
         ++pass;
         samplesDone += pixelsPerPass * count;

@@ -368,6 +368,25 @@ const Extreme kExtremes[] = {
 INSTANTIATE_TEST_SUITE_P(Hemi, GuideExtremes, ::testing::ValuesIn(kExtremes),
                          [](const auto& info) { return std::string(info.param.name); });
 
+// rr=adjoint plays Russian roulette after bounce 3 on the expected contribution (throughput x
+// learned Q against the pixel's estimate). In an emitting enclosure with 12 bounces it runs on
+// most deep vertices; the answer must not move, and the image must differ from pbrt-v3's
+// roulette (the adjoint one ran).
+TEST(AdjointRoulette, EnclosureStaysExact) {
+    const std::string scene = enclosure(0.5, 1.0, 12);
+    for (const char* backend : {"hemi", "vdb"}) {
+        Rendered adjoint = renderText(scene, backend, {{"rr", "adjoint"}, {"warmup", "0"}});
+        expectMean(adjoint, series(0.5, 1.0, 12), std::string(backend) + " rr=adjoint");
+        Rendered plain = renderText(scene, backend, {{"rr", "pbrt"}, {"warmup", "0"}});
+        ASSERT_TRUE(plain.ok);
+        ASSERT_TRUE(adjoint.ok);
+        double diff = 0.0;
+        for (size_t i = 0; i < plain.image.pixels.size(); ++i)
+            diff += std::abs(double(plain.image.pixels[i]) - double(adjoint.image.pixels[i]));
+        EXPECT_GT(diff, 0.0) << backend;
+    }
+}
+
 // The vdb backend's medium tables at their extremes: pure policy without warmup, no uniform
 // floor, one voxel for the whole medium, the finest grid. The thick forward-scattering fog
 // runs only where the phase function stays in the mixture (mix < 1 bounds each vertex's
