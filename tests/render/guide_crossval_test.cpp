@@ -131,9 +131,15 @@ TEST(GuideCrossValidation, IntegratorParametersAreValidated) {
     EXPECT_EQ(gs.autoSpp, 0);  // always guide unless asked
     ASSERT_TRUE(setup({{"auto", "16"}}, &gs, &err)) << err;
     EXPECT_EQ(gs.autoSpp, 16);
+    EXPECT_TRUE(gs.adjointRoulette);  // the default
+    ASSERT_TRUE(setup({{"rr", "pbrt"}}, &gs, &err)) << err;
+    EXPECT_FALSE(gs.adjointRoulette);
+    ASSERT_TRUE(setup({{"rr", "adjoint"}}, &gs, &err)) << err;
+    EXPECT_TRUE(gs.adjointRoulette);
     for (const auto& bad : std::vector<std::map<std::string, std::string>>{
              {{"mix", "learnt"}}, {{"mix", "1.5"}}, {{"samples", "random"}},
-             {{"target", "all"}}, {{"auto", "-1"}}, {{"auto", "16x"}}, {{"auto", ""}}}) {
+             {{"target", "all"}}, {{"auto", "-1"}}, {{"auto", "16x"}}, {{"auto", ""}},
+             {{"rr", "russian"}}}) {
         err.clear();
         EXPECT_FALSE(setup(bad, &gs, &err)) << bad.begin()->first;
         EXPECT_NE(err.find(bad.begin()->first), std::string::npos) << err;
