@@ -411,9 +411,17 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         SurfaceInteraction si;
         ++stats.rays;
         bool found = scene_.intersect(ray, &si);
+        // The path's last direction (no vertex after it) brings back only the emission it
+        // hits, weighted against this vertex's next-event estimation: the learned Q, the light
+        // of whole returns, overstates what it can find there, and its truncated return would
+        // understate Q for the vertices before the last. It samples the BSDF and records no
+        // return (Eq. 1 targets, bootstrapped from Q, are learned there as everywhere), so a
+        // surface vertex looks up a region only before it or to bootstrap.
+        const bool lastDirection = bounces + 1 >= maxDepth_;
+        const bool wantsRegion = field && (!lastDirection || bootstrap);
         // The lookup below reads a table entry for si.p: start loading it (a cache miss
         // otherwise; the material evaluation runs in between).
-        if (found && field && (bounces + 1 < maxDepth_ || bootstrap)) field->prefetch(si.p);
+        if (found && wantsRegion) field->prefetch(si.p);
         if (media && pm.medium >= 0) {
             // Free flight to the surface (or to infinity) through the current medium.
             const Medium& medium = *scene_.media[size_t(pm.medium)];
@@ -517,14 +525,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         bsdf.clear();
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
         const bool canGuide = field && guidable(bsdf);
-        // The path's last direction (no vertex after it) brings back only the emission it
-        // hits, weighted against this vertex's next-event estimation: the learned Q, the light
-        // of whole returns, overstates what it can find there, and its truncated return would
-        // understate Q for the vertices before the last. It samples the BSDF and records no
-        // return (Eq. 1 targets, bootstrapped from Q, are learned there as everywhere).
-        const bool lastDirection = bounces + 1 >= maxDepth_;
         int region = -1;
-        if (canGuide && (!lastDirection || bootstrap)) {
+        if (canGuide && wantsRegion) {
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
             region = field->lookup(si.p, nFacing);
         }

@@ -47,6 +47,52 @@ void printProgress(int pass, int spp, int totalSpp, double elapsed, double budge
     std::fflush(stderr);
 }
 
+// Adjoint-driven roulette's pixel estimates: the luminance of the image so far, averaged
+// over 3x3 pixels (fewer outliers), in the radiance units of Li (without the film's scale).
+// 0 (unknown) until the first refresh.
+class PixelEstimates {
+public:
+    explicit PixelEstimates(const Bounds2i& bounds)
+        : bounds_(bounds), w_(bounds.pMax.x - bounds.pMin.x), h_(bounds.pMax.y - bounds.pMin.y) {}
+
+    void refresh(const Film& film) {
+        const Image img = film.toImage();
+        const float scale = film.params().scale;
+        if (img.width != w_ || img.height != h_ || w_ <= 0 || h_ <= 0 || !(scale > 0.f)) return;
+        std::vector<float> lum(size_t(w_) * size_t(h_));
+        for (int y = 0; y < h_; ++y)
+            for (int x = 0; x < w_; ++x)
+                lum[index(x, y)] = std::max(0.f, luminance(Spectrum(img.at(x, y, 0),
+                                                                    img.at(x, y, 1),
+                                                                    img.at(x, y, 2)))) /
+                                   scale;
+        values_.assign(lum.size(), 0.f);
+        for (int y = 0; y < h_; ++y)
+            for (int x = 0; x < w_; ++x) {
+                float sum = 0.f;
+                int n = 0;
+                for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, h_ - 1); ++yy)
+                    for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, w_ - 1); ++xx, ++n)
+                        sum += lum[index(xx, yy)];
+                const float e = sum / float(n);
+                values_[index(x, y)] = std::isfinite(e) ? e : 0.f;
+            }
+    }
+    // The estimate at a sample pixel (full-image coordinates; outside the stored pixels, the
+    // nearest stored one).
+    float at(int x, int y) const {
+        if (values_.empty()) return 0.f;
+        return values_[index(std::clamp(x - bounds_.pMin.x, 0, w_ - 1),
+                             std::clamp(y - bounds_.pMin.y, 0, h_ - 1))];
+    }
+
+private:
+    size_t index(int x, int y) const { return size_t(y) * size_t(w_) + size_t(x); }
+    Bounds2i bounds_;
+    int w_, h_;
+    std::vector<float> values_;
+};
+
 }  // namespace
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
@@ -92,46 +138,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     std::vector<std::unique_ptr<FilmTile>> tileFilms(tiles.size());
     for (size_t i = 0; i < tiles.size(); ++i) tileFilms[i] = film.makeTile(tiles[i]);
 
-    // Adjoint-driven roulette's pixel estimates (PathIntegrator::wantsPixelEstimate): the
-    // luminance of the image so far, averaged over 3x3 pixels (fewer outliers), in the
-    // radiance units of Li (without the film's scale); refreshed after every guided pass.
-    const Bounds2i estBounds = film.pixelBounds();
-    std::vector<float> pixelEstimate;
-    auto refreshEstimates = [&] {
-        const Image img = film.toImage();
-        const int w = img.width, h = img.height;
-        const float scale = film.params().scale;
-        if (w <= 0 || h <= 0 || !(scale > 0.f)) return;
-        std::vector<float> lum(size_t(w) * size_t(h));
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x)
-                lum[size_t(y) * w + x] =
-                    std::max(0.f, luminance(Spectrum(img.at(x, y, 0), img.at(x, y, 1),
-                                                     img.at(x, y, 2)))) / scale;
-        pixelEstimate.assign(lum.size(), 0.f);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                float sum = 0.f;
-                int n = 0;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xx = x + dx, yy = y + dy;
-                        if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-                        sum += lum[size_t(yy) * w + xx];
-                        ++n;
-                    }
-                const float e = sum / float(n);
-                pixelEstimate[size_t(y) * w + x] = std::isfinite(e) ? e : 0.f;
-            }
-    };
-    auto estimateAt = [&](int x, int y) {
-        if (pixelEstimate.empty()) return 0.f;
-        const int w = estBounds.pMax.x - estBounds.pMin.x;
-        const int h = estBounds.pMax.y - estBounds.pMin.y;
-        const int xx = std::clamp(x - estBounds.pMin.x, 0, w - 1);
-        const int yy = std::clamp(y - estBounds.pMin.y, 0, h - 1);
-        return pixelEstimate[size_t(yy) * w + xx];
-    };
+    // Adjoint-driven roulette's pixel estimates (PathIntegrator::wantsPixelEstimate),
+    // refreshed after every guided pass.
+    PixelEstimates estimates(film.pixelBounds());
 
     double start = now();
     long long samplesDone = 0;
@@ -192,7 +201,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 for (int y = b.pMin.y; y < b.pMax.y; ++y)
                     for (int x = b.pMin.x; x < b.pMax.x; ++x) {
                         PixelMoments pixel;
-                        const float estimate = estimateAt(x, y);
+                        const float estimate = estimates.at(x, y);
                         PassMoments* const into = moments ? moments : history.get();
                         const bool measured = into && into->tracked(x, y);
                         for (int s = first; s < first + count; ++s) {
@@ -251,7 +260,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         }
         film.mergeTiles(tileFilms);
         for (auto& t : tileFilms) t->clear();
-        if (guidedPass && passIntegrator.wantsPixelEstimate()) refreshEstimates();
+        if (guidedPass && passIntegrator.wantsPixelEstimate()) estimates.refresh(film);
         result.spp += count;
         ++pass;
         samplesDone += pixelsPerPass * count;
