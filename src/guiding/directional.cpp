@@ -5,7 +5,7 @@
 namespace rlpbrt::guiding {
 
 StrataLayout::StrataLayout(int cols, int rows) : cols_(cols), rows_(rows) {
-    octantShift_ = cols == 2 ? 2 : cols == 4 ? 1 : cols == 8 ? 0 : -1;
+    octantShift_ = cols == 2 ? 2 : cols == 4 ? 1 : (cols == 8 || cols == 16) ? 0 : -1;
     centres_.resize(static_cast<size_t>(cols) * static_cast<size_t>(rows));
     for (int row = 0; row < rows; ++row) {
         // Centre in the map's coordinates: cos(theta) and phi at the middle of the cell.

@@ -94,7 +94,7 @@ public:
         row = row < rows_ - 1 ? row : rows_ - 1;
         int col = 0;
         if (octantShift_ >= 0) {
-            // cols_ divides 8: the column from the octant of (x, y), by comparisons only.
+            // cols_ divides 16: the column from the octant of (x, y), by comparisons only.
             const float x = local.x, y = local.y;
             if (!(x == x) || !(y == y)) return -1;  // NaN components
             // Quadrant q (counter-clockwise from +x), then the half of it: branch-free, as the
@@ -104,7 +104,17 @@ public:
             const int q = (ny << 1) | (nx ^ ny);
             const float ax = std::abs(x), ay = std::abs(y);
             const int half = (q & 1) ? int(ax >= ay) : int(ay >= ax) & int(ay > 0.f);
-            col = (q * 2 + half) >> octantShift_;
+            if (cols_ != 16) {
+                col = (q * 2 + half) >> octantShift_;
+            } else {
+                // 16 columns: the half of the octant, from the tangent of 22.5 degrees. a is
+                // the component that grows with the azimuth inside the quadrant, b the other.
+                constexpr float kTan22_5 = 0.41421356237309503f;
+                const float a = (q & 1) ? ax : ay, b = (q & 1) ? ay : ax;
+                const int sub =
+                    half ? int(b <= kTan22_5 * a) : int(a >= kTan22_5 * b) & int(a > 0.f);
+                col = (q * 2 + half) * 2 + sub;
+            }
         } else if (cols_ > 1) {
             float phi = azimuth(local.x, local.y);
             if (!(phi >= 0.f)) return -1;  // NaN components
@@ -144,7 +154,9 @@ public:
 
 private:
     int cols_, rows_;
-    int octantShift_ = -1;  // column = octant >> this for 2, 4, 8 columns (2, 1, 0); else -1
+    // column = octant >> this for 2, 4, 8 columns (2, 1, 0); 0 also for 16 columns (the
+    // octant's halves); else -1 (the azimuth)
+    int octantShift_ = -1;
     std::vector<glm::vec3> centres_;
 };
 

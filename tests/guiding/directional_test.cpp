@@ -57,10 +57,10 @@ TEST(StrataLayout, IndexEdgesClamp) {
 }
 
 TEST(StrataLayout, OctantColumnsMatchTheAzimuth) {
-    // Column counts dividing 8 take the column from comparisons (branch-free octants); it
-    // must be the azimuth's column for every direction off the octant edges.
+    // Column counts dividing 16 take the column from comparisons (branch-free octants and
+    // their halves); it must be the azimuth's column for every direction off the edges.
     std::mt19937_64 rng(5);
-    for (int cols : {1, 2, 4, 8}) {
+    for (int cols : {1, 2, 4, 8, 16}) {
         StrataLayout layout(cols, 3);
         int checked = 0;
         for (int i = 0; i < 20000; ++i) {
