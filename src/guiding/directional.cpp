@@ -20,6 +20,22 @@ StrataLayout::StrataLayout(int cols, int rows) : cols_(cols), rows_(rows) {
     }
 }
 
+std::vector<std::vector<uint32_t>> StrataLayout::quadtree() const {
+    std::vector<std::vector<uint32_t>> levels;
+    int c = cols_, r = rows_;
+    do {
+        const int pc = (c + 1) / 2, pr = (r + 1) / 2;
+        std::vector<uint32_t> map(static_cast<size_t>(c) * static_cast<size_t>(r));
+        for (int row = 0; row < r; ++row)
+            for (int col = 0; col < c; ++col)
+                map[static_cast<size_t>(row * c + col)] = uint32_t((row / 2) * pc + col / 2);
+        levels.push_back(std::move(map));
+        c = pc;
+        r = pr;
+    } while (c * r > 1);
+    return levels;
+}
+
 void buildStrataCdf(const double* q, int n, double epsilon, float* cdf) {
     double sum = 0.0;
     for (int j = 0; j < n; ++j) sum += q[j];

@@ -135,6 +135,12 @@ public:
         return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
     }
 
+    // The strata as the leaves of a quadtree over the (cos theta, phi) grid, for
+    // StrataTable::setSmoothing: level 0 maps stratum (row, col) to node (row / 2, col / 2) of
+    // a grid of ceil(cols / 2) x ceil(rows / 2), each next level halves that grid likewise, and
+    // the last level maps to the single root (node indices row-major in their grid).
+    std::vector<std::vector<uint32_t>> quadtree() const;
+
     // Local unit direction of stratum j's centre (its representative direction).
     const glm::vec3& centre(int j) const { return centres_[static_cast<size_t>(j)]; }
 

@@ -161,10 +161,15 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (value != "cell" && value != "exact")
                 return badValue("hemi", key, value, "cell or exact", error);
             hp->cellLookup = value == "cell";
+        } else if (key == "smooth") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
+                return badValue("hemi", key, value, "a number in [0, 1e9]", error);
+            hp->smooth = d;
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, warmup, lookup, max-mb, mix, target, samples, auto, rr)";
+                     "cosine, warmup, lookup, smooth, max-mb, mix, target, samples, auto, rr)";
             return false;
         }
     }

@@ -157,7 +157,8 @@ public:
 // (parameters are ignored). Unknown backend or parameter, or a bad value => nullptr and a
 // message in *error. Backend "hemi" parameters:
 //   alpha        "visits" (default: 1/(1+visits), batch running mean) or a number in (0,1]
-//   strata       "WxH" (default 8x8): W columns in phi, H rows in cos(theta), each 1..64;
+//   strata       "WxH" (default 16x16 for hemi, 8x8 for vdb): W columns in phi, H rows in
+//                cos(theta), each 1..64;
 //                "N" means NxN
 //   points       surface samples, 1..2^26 (default 2048); each gives two hemispheres (n, -n)
 //   normal-angle admissible normal deviation in degrees, (0, 180) (default 30)
@@ -168,8 +169,10 @@ public:
 //                cell (cells of the points' mean spacing), memoised per cell; "exact": the
 //                knn points nearest to the vertex (kd-tree query per vertex)
 //   warmup       records per stratum until a region's policy gets the full mixture weight:
-//                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 16;
-//                0 = always full weight, the paper's behaviour)
+//                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 8 for
+//                hemi, 16 for vdb; 0 = always full weight, the paper's behaviour)
+//   smooth       hemi: prior strength, in visits, of the hierarchical smoothing of the
+//                strata estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
 //   mix, target, samples, auto

@@ -82,8 +82,15 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     const size_t regions = positions_.size() * 2;
     frames_.resize(regions);
     for (size_t r = 0; r < regions; ++r) frames_[r].frame = HemiFrame::fromZ(regionNormal(int(r)));
+    if (params.smooth > 0.0)
+        table_.setSmoothing(layout_.quadtree(), params.smooth, params.init);
     table_.reset(regions, strata_, params.init, policy());
-    for (size_t r = 0; r < regions; ++r) updateRegion(int(r));
+    // (reset built region 0 and copied it to the others)
+    if (regions > 0) {
+        std::vector<double> est(static_cast<size_t>(strata_));
+        table_.estimate(0, est.data());
+        for (size_t r = 1; r < regions; ++r) updateRegion(int(r), est.data());
+    }
 }
 
 HemiField::~HemiField() = default;
@@ -170,7 +177,7 @@ float HemiField::scatteredEstimate(int region,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (!validRegion(region)) return 0.f;
     const HemiFrame& frame = frames_[size_t(region)].frame;
-    const double* q = table_.q(size_t(region));
+    const float* q = table_.estimates(size_t(region));
     double acc = 0.0;
     for (int j = 0; j < strata_; ++j) {
         float f = fcos(frame.toWorld(layout_.centre(j)));
@@ -201,8 +208,7 @@ void HemiField::recordSelection(int slot, int region, const SelectionSample& s) 
 
 float HemiField::radiance(int region, const glm::vec3& w) const {
     int j = stratumOf(region, w);
-    if (j < 0) return 0.f;
-    return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
+    return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
 void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
@@ -211,8 +217,7 @@ void HemiField::record(int slot, int region, const glm::vec3& w, float target) {
     table_.record(slot, region, target, [&] { return stratumOf(region, w); });
 }
 
-void HemiField::updateRegion(int region) {
-    const double* q = table_.q(size_t(region));
+void HemiField::updateRegion(int region, const double* q) {
     double m[3] = {0.0, 0.0, 0.0};
     for (int j = 0; j < strata_; ++j) {
         const glm::vec3& c = layout_.centre(j);

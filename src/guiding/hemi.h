@@ -24,7 +24,13 @@ namespace rlpbrt::guiding {
 struct HemiParams {
     bool alphaVisits = true;     // alpha = 1/(1 + visits) if true, else fixedAlpha
     double fixedAlpha = 1.0;     // in (0, 1]
-    int cols = 8, rows = 8;      // strata in phi and in cos(theta)
+    // Strata in phi and in cos(theta). 16x16, not the paper's 8x8: a trained 16x16 guide
+    // resolves the small bright patches that light indirectly lit scenes. Per sample with a
+    // guide trained for 1024 spp (64 spp, seeds 2/3, relMSE): veach-bidir 0.116/0.110 (8x8)
+    // -> 0.062/0.062, breakfast 3.87/4.03 -> 3.20/2.78. At 30 s against none (pinned pairs,
+    // both core orders, docs/BENCHMARKS.md): veach-bidir 0.53 -> 0.39, breakfast 0.58 ->
+    // 0.48, killeroo 1.10 -> 1.04, cornell-box 1.07 -> 1.10, conference-room 1.08 -> 1.17.
+    int cols = 16, rows = 16;
     // Surface samples (two hemispheres each). Fewer regions learn faster: measured relMSE
     // (64 spp, seeds 2/3/4) veach-bidir 0.255/0.307/0.279 with 8192 points against
     // 0.185/0.195/0.191 with 2048 (and 0.0644 against 0.0475 at 256 spp), breakfast
@@ -42,9 +48,13 @@ struct HemiParams {
     bool cosine = true;
     // Confidence of a region = visits / (visits + warmup * strata): the integrator scales its
     // mixture probability by it, so barely trained regions sample mostly the BSDF. Measured at
-    // 64 spp (relMSE; none: 0.331, 6.95, 0.0176): warmup 1 -> veach-bidir 0.345, breakfast
-    // 4.46, buddha-fractal 0.0215; 8 -> 0.266, 5.42, 0.0208; 16 -> 0.251, 5.75, 0.0202.
-    double warmup = 16.0;
+    // 64 spp with 8x8 strata (relMSE; none: 0.331, 6.95, 0.0176): warmup 1 -> veach-bidir
+    // 0.345, breakfast 4.46, buddha-fractal 0.0215; 8 -> 0.266, 5.42, 0.0208; 16 -> 0.251,
+    // 5.75, 0.0202. With 16x16 strata, 8 (2048 records per region for confidence 1/2; 1024 at
+    // 8x8 and 16): at 30 s against none veach-bidir 0.42 / 0.39 / 0.47 with warmup 4 / 8 /
+    // 16, breakfast 0.56 / 0.48 / 0.53, cornell-box 1.10 / 1.10 / 1.17, killeroo 1.19 / 1.04
+    // / 1.09 (three runs at different times of day: the machine's speed varied by 20%).
+    double warmup = 8.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree
@@ -53,6 +63,17 @@ struct HemiParams {
     // (64 spp relMSE, seeds 2/3: veach-bidir 0.168/0.176 -> 0.165/0.159, breakfast 5.73/5.08
     // -> 5.27/4.49, buddha-fractal, killeroo, cornell-box within 1.5%).
     bool cellLookup = true;
+    // Prior strength, in visits, of the hierarchical smoothing of the strata estimates
+    // (StrataTable::setSmoothing over StrataLayout::quadtree): a stratum with few visits
+    // borrows the mean of the 2x2, 4x4, ... strata around it instead of keeping init. 0 = off
+    // (each stratum its own Q, the paper's). Its measured effect is on the bias of the
+    // default samples=sequence (docs/STABILITY.md): an unvisited stratum no longer looks
+    // dark, so the samples a pixel's sequence places where its earlier samples did not go do
+    // not meet a policy that learned to avoid those directions. White furnace, 64 spp, seeds
+    // 1-4, mean against 1: 16x16 strata, warmup 8: +0.025% to +0.074% -> -0.007% to +0.005%;
+    // 8x8, warmup 16: +0.008% to +0.019% -> -0.001% to +0.012%. At equal time (30 s) it is
+    // within the noise of the runs (docs/BENCHMARKS.md).
+    double smooth = 2.0;
 };
 
 // Estimated bytes of a hemi field with these parameters (tables, CDFs, points, kd-tree).
@@ -124,8 +145,8 @@ private:
     void buildPolicy(const double* q, float* cdf) const;
     // Starts loading the data the per-vertex queries read for a region; returns region.
     int prefetched(int region) const;
-    // Refreshes a region's moment and confidence from its Q and visits (after a CDF build).
-    void updateRegion(int region);
+    // Refreshes a region's moment (from its estimates q) and confidence (after a CDF build).
+    void updateRegion(int region, const double* q);
 
     bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
     const float* cdf(int region) const { return table_.cdf(size_t(region)); }
@@ -134,7 +155,7 @@ private:
     StrataTable::PolicyBuilder policy() {
         return [this](int region, const double* q, float* c) {
             buildPolicy(q, c);
-            if (size_t(region) < frames_.size()) updateRegion(region);
+            if (size_t(region) < frames_.size()) updateRegion(region, q);
         };
     }
 

@@ -16,14 +16,16 @@ void StrataTable::reset(size_t regions, int strata, double init, const PolicyBui
     strata_ = strata;
     const size_t n = size_t(strata);
     q_.assign(regions * n, init);
-    qf_.assign(regions * n, float(std::min(init, double(FLT_MAX))));
+    est_.assign(regions * n, float(std::min(init, double(FLT_MAX))));
     visits_.assign(regions * n, 0);
     cdf_.assign(regions * (n + 1), 0.f);
-    // Every region starts with the same Q: build the first CDF and copy it.
+    // Every region starts with the same Q and no visits: build the first one and copy it.
     if (regions > 0) {
-        policy(0, q(0), cdf_.data());
-        for (size_t r = 1; r < regions; ++r)
+        rebuild(0, policy);
+        for (size_t r = 1; r < regions; ++r) {
             std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
+            std::copy(est_.begin(), est_.begin() + long(n), est_.begin() + long(r * n));
+        }
     }
     slots_.clear();
     stats_ = GuidingStats();
@@ -36,20 +38,85 @@ void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy)
     regions_ = regions;
     selection_.grow(regions);
     q_.resize(regions * n, init);
-    qf_.resize(regions * n, float(std::min(init, double(FLT_MAX))));
+    est_.resize(regions * n, float(std::min(init, double(FLT_MAX))));
     visits_.resize(regions * n, 0);
     cdf_.resize(regions * (n + 1), 0.f);
-    for (size_t r = old; r < regions; ++r) policy(int(r), q(r), &cdf_[r * (n + 1)]);
+    for (size_t r = old; r < regions; ++r) rebuild(r, policy);
 }
 
 void StrataTable::assign(std::vector<double> q, std::vector<uint64_t> visits,
                          const PolicyBuilder& policy) {
     q_ = std::move(q);
     visits_ = std::move(visits);
-    for (size_t r = 0; r < regions_; ++r) {
-        policy(int(r), this->q(r), &cdf_[r * size_t(strata_ + 1)]);
-        mirror(r);
+    for (size_t r = 0; r < regions_; ++r) rebuild(r, policy);
+}
+
+void StrataTable::setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior,
+                               double init) {
+    levels_.clear();
+    levelSize_.clear();
+    prior_ = prior > 0.0 && std::isfinite(prior) ? prior : 0.0;
+    smoothInit_ = init;
+    if (prior_ == 0.0) return;
+    levels_ = std::move(levels);
+    for (const std::vector<uint32_t>& map : levels_) {
+        uint32_t size = 0;
+        for (uint32_t parent : map) size = std::max(size, parent + 1);
+        levelSize_.push_back(size);
     }
+}
+
+void StrataTable::estimate(size_t region, double* out) const {
+    const double* q = this->q(region);
+    if (levels_.empty()) {
+        std::copy(q, q + strata_, out);
+        return;
+    }
+    const uint64_t* v = visits(region);
+    // Per node above the strata (level by level, offsets into one buffer): the visits under
+    // it, the sum of their targets and its estimate.
+    const size_t levels = levels_.size();
+    std::vector<size_t> offset(levels + 1, 0);
+    for (size_t l = 0; l < levels; ++l) offset[l + 1] = offset[l] + levelSize_[l];
+    const size_t nodes = offset[levels];
+    std::vector<double> buf(3 * nodes, 0.0);
+    double *sum = buf.data(), *count = sum + nodes, *est = count + nodes;
+    // Bottom-up: strata into level 1, each level into the next.
+    for (size_t l = 0; l < levels; ++l) {
+        const std::vector<uint32_t>& map = levels_[l];
+        for (size_t i = 0; i < map.size(); ++i) {
+            const size_t parent = offset[l] + map[i];
+            sum[parent] += l == 0 ? double(v[i]) * q[i] : sum[offset[l - 1] + i];
+            count[parent] += l == 0 ? double(v[i]) : count[offset[l - 1] + i];
+        }
+    }
+    // Top-down: each node shrunk towards its parent's estimate. The root takes the mean of
+    // all its targets (init before any): a prior of init there would pull every estimate
+    // towards a scale unrelated to the scene's radiance.
+    for (size_t l = levels; l-- > 0;) {
+        for (size_t i = 0; i < levelSize_[l]; ++i) {
+            const size_t node = offset[l] + i;
+            if (l + 1 == levels) {
+                est[node] = count[node] > 0.0 ? sum[node] / count[node] : smoothInit_;
+                continue;
+            }
+            const double parent = est[offset[l + 1] + levels_[l + 1][i]];
+            est[node] = (sum[node] + prior_ * parent) / (count[node] + prior_);
+        }
+    }
+    for (int j = 0; j < strata_; ++j) {
+        const double parent = est[levels_[0][size_t(j)]];
+        const double n = double(v[j]);
+        out[j] = (n * q[j] + prior_ * parent) / (n + prior_);
+    }
+}
+
+void StrataTable::rebuild(size_t region, const PolicyBuilder& policy) {
+    std::vector<double> e(static_cast<size_t>(strata_));
+    estimate(region, e.data());
+    policy(int(region), e.data(), &cdf_[region * size_t(strata_ + 1)]);
+    float* out = &est_[region * size_t(strata_)];
+    for (int j = 0; j < strata_; ++j) out[j] = float(std::min(e[j], double(FLT_MAX)));
 }
 
 void StrataTable::beginPass(int numSlots) {
@@ -60,12 +127,6 @@ void StrataTable::beginPass(int numSlots) {
         s.rejectedTargets = s.rejectedRecords = 0;
     }
     selection_.beginPass(numSlots);
-}
-
-void StrataTable::mirror(size_t region) {
-    const double* qd = &q_[region * size_t(strata_)];
-    float* qs = &qf_[region * size_t(strata_)];
-    for (int j = 0; j < strata_; ++j) qs[j] = float(std::min(qd[j], double(FLT_MAX)));
 }
 
 void StrataTable::applyRegion(size_t region, const Record* begin, const Record* end,
@@ -96,8 +157,7 @@ void StrataTable::applyRegion(size_t region, const Record* begin, const Record* 
         q[j] = (std::isfinite(updated) && updated >= 0.0) ? updated : mean;
         visits[j] += m;
     }
-    policy(int(region), q, &cdf_[region * size_t(strata_ + 1)]);
-    mirror(region);
+    rebuild(region, policy);
 }
 
 void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy) {
@@ -138,7 +198,7 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
 }
 
 size_t StrataTable::bytes() const {
-    return q_.capacity() * sizeof(double) + qf_.capacity() * sizeof(float) +
+    return q_.capacity() * sizeof(double) + est_.capacity() * sizeof(float) +
            visits_.capacity() * sizeof(uint64_t) + cdf_.capacity() * sizeof(float) +
            selection_.bytes();
 }

@@ -1,8 +1,9 @@
 // The learned part of a guiding field, independent of how regions are placed in space: per
-// region a table of strata holding Q (double, and a float copy for the per-vertex estimates),
-// visit counts and the frozen sampling CDF; per-slot record buffers and the deterministic
-// slot-ordered batch merge of Eq. 1 between passes (notes section 4). Shared by the hemi and
-// vdb backends; standard library and TBB only.
+// region a table of strata holding Q (double), visit counts, the float estimates that
+// queries read (Q itself, or Q smoothed over a hierarchy of strata) and the frozen sampling
+// CDF; per-slot record buffers and the deterministic slot-ordered batch merge of Eq. 1
+// between passes (notes section 4). Shared by the hemi and vdb backends; standard library and
+// TBB only.
 #pragma once
 
 #include <cmath>
@@ -18,7 +19,8 @@ namespace rlpbrt::guiding {
 
 class StrataTable {
 public:
-    // Rebuilds one region's CDF (strata + 1 floats) from its Q (strata doubles).
+    // Rebuilds one region's CDF (strata + 1 floats) from its estimates (strata doubles: Q, or
+    // Q smoothed, see setSmoothing).
     using PolicyBuilder = std::function<void(int region, const double* q, float* cdf)>;
 
     // regions x strata entries, every Q = init, no visits; CDFs built with `policy` (which
@@ -32,7 +34,22 @@ public:
     size_t regions() const { return regions_; }
     int strata() const { return strata_; }
     const double* q(size_t region) const { return &q_[region * size_t(strata_)]; }
-    const float* qf(size_t region) const { return &qf_[region * size_t(strata_)]; }
+    // The estimates of a region's strata that queries and the policy use, frozen per pass:
+    // Q itself, or with smoothing the shrunken estimates below.
+    const float* estimates(size_t region) const { return &est_[region * size_t(strata_)]; }
+
+    // Hierarchical smoothing of the estimates (Bayesian shrinkage; off until set): the strata
+    // are the leaves of a tree whose levels are given by parent maps (levels[0][j] = the node
+    // of level 1 that holds stratum j, levels[1][i] = the parent of that node, ..., the last
+    // level has a single node, the root). A node's estimate is (S + prior * parent's estimate)
+    // / (N + prior), with N the visits under it and S the sum of their targets (visits x Q
+    // for a stratum); the root's is S / N (`init` while N = 0). A stratum with few visits thus
+    // borrows its coarser neighbourhood's mean, one with many keeps its own Q: a fine table
+    // learns as fast as a coarse one early and resolves more later. prior 0 or no levels:
+    // the estimates are Q. Call before reset()/grow()/assign() build the policy.
+    void setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior, double init);
+    // The (unrounded) estimates of one region, strata doubles.
+    void estimate(size_t region, double* out) const;
     const uint64_t* visits(size_t region) const { return &visits_[region * size_t(strata_)]; }
     const float* cdf(size_t region) const { return &cdf_[region * size_t(strata_ + 1)]; }
 
@@ -87,7 +104,7 @@ public:
     GuidingStats& stats() { return stats_; }
     const GuidingStats& stats() const { return stats_; }
 
-    // Learned data (Q, float Q, visits, CDFs) and per-pass scratch, in bytes.
+    // Learned data (Q, estimates, visits, CDFs) and per-pass scratch, in bytes.
     size_t bytes() const;
     size_t scratchBytes() const;
 
@@ -105,12 +122,16 @@ private:
     void applyRegion(size_t region, const Record* begin, const Record* end, bool alphaVisits,
                      double fixedAlpha, double* sums, uint64_t* counts,
                      const PolicyBuilder& policy);
-    void mirror(size_t region);
+    // Rebuilds a region's estimates and its CDF.
+    void rebuild(size_t region, const PolicyBuilder& policy);
 
     size_t regions_ = 0;
     int strata_ = 0;
     std::vector<double> q_;
-    std::vector<float> qf_;
+    std::vector<float> est_;
+    std::vector<std::vector<uint32_t>> levels_;  // setSmoothing's tree (empty: none)
+    std::vector<uint32_t> levelSize_;            // nodes per level above the strata
+    double prior_ = 0.0, smoothInit_ = 0.0;
     std::vector<uint64_t> visits_;
     std::vector<float> cdf_;
     std::vector<SlotBuffer> slots_;

@@ -424,7 +424,7 @@ float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
             cell, [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });
     if (!validRegion(region) || !finite3(n)) return 0.f;
     const glm::vec3 nl = frames_[size_t(region)].toLocal(n);
-    const float* q = table_.qf(size_t(region));
+    const float* q = table_.estimates(size_t(region));
     const float *cx = centreX_.data(), *cy = centreY_.data(), *cz = centreZ_.data();
     float acc = 0.f;
     for (int j = 0, s = table_.strata(); j < s; ++j) {

@@ -90,7 +90,7 @@ glm::vec3 VdbVolume::sample(int cell, glm::vec2 u, float uStratum, float* pdfOut
 float VdbVolume::radiance(int cell, const glm::vec3& w) const {
     if (cell < 0 || cell >= cells()) return 0.f;
     const int j = stratumOf(w);
-    return j < 0 ? 0.f : table_.qf(size_t(cell))[j];
+    return j < 0 ? 0.f : table_.estimates(size_t(cell))[j];
 }
 
 float VdbVolume::scatteredEstimate(int cell,

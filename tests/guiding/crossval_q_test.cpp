@@ -47,7 +47,8 @@ struct Cell {
 // estimate the same number: they must agree within 5 standard errors of their difference
 // (each from its cell's sample variance and count).
 TEST(GuideCrossValidation, HemiAndVdbLearnTheSameQ) {
-    auto hemi = make("hemi", {{"points", "16"}, {"strata", "4x4"}});
+    // (smooth=0: radiance() is then Q itself, the running mean compared below)
+    auto hemi = make("hemi", {{"points", "16"}, {"strata", "4x4"}, {"smooth", "0"}});
     auto vdb = make("vdb", {{"voxel", "4"}, {"strata", "4x4"}});
     ASSERT_TRUE(hemi && vdb);
     auto* h = dynamic_cast<HemiField*>(hemi.get());

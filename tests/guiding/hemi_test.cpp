@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "guiding/test_scenes.h"
@@ -166,10 +167,13 @@ TEST(HemiField, DefaultsAndMemory) {
     auto f = makeHemi(planeScene());
     ASSERT_TRUE(f);
     EXPECT_EQ(f->numRegions(), 2 * 2048);
-    EXPECT_EQ(f->layout().count(), 64);
+    EXPECT_EQ(f->layout().count(), 256);  // 16x16
     EXPECT_TRUE(f->params().alphaVisits);
-    // Q (double), visits (uint64), CDF (65 floats), frame and moment per region dominate.
-    const size_t tables = size_t(f->numRegions()) * (64 * 20 + 65 * 4 + 64);
+    EXPECT_EQ(f->params().warmup, 8.0);
+    EXPECT_EQ(f->params().smooth, 2.0);
+    // Q (double), estimates (float), visits (uint64), CDF (257 floats), frame and moment per
+    // region dominate.
+    const size_t tables = size_t(f->numRegions()) * (256 * 20 + 257 * 4 + 64);
     EXPECT_GE(f->bytes(), tables);
     // Points, tree and the lookup's cell memo: 16384 entries of one cache line.
     ASSERT_NE(f->cellCache(), nullptr);
@@ -344,6 +348,60 @@ TEST(HemiField, UntrainedSamplingMatchesPdf) {
     }
 }
 
+// Hierarchical smoothing (smooth=K): 8 records of 100 in one stratum and 8 of 0 in a distant
+// one, none elsewhere. Without smoothing the other strata keep init. With it, the root takes
+// the mean of all targets (50) and every node below it the mean of the targets under it,
+// shrunk towards its parent: the unvisited sibling in the bright stratum's 2x2 block gets
+// nearly its block's mean, a stratum in an unvisited quarter of the hemisphere the root's
+// mean, and the dark stratum stays near 0. The smoothed policy is sampled exactly by its pdf.
+TEST(HemiField, SmoothingSpreadsSparseVisitsAndKeepsThePdfExact) {
+    for (const char* smooth : {"0", "2"}) {
+        auto f = makeHemi(planeScene(),
+                          {{"points", "16"}, {"strata", "16x16"}, {"smooth", smooth}});
+        ASSERT_TRUE(f);
+        const int region = 4;
+        const int bright = 5 * 16 + 6;  // row 5, column 6: its 2x2 block holds columns 6, 7
+        const int sibling = 5 * 16 + 7, far = 5 * 16 + 14, dark = 12 * 16 + 2;
+        auto at = [&](int j) { return f->radiance(region, strataCentre(*f, region, j)); };
+        f->beginPass(1);
+        for (int i = 0; i < 8; ++i) {
+            f->record(0, region, strataCentre(*f, region, bright), 100.f);
+            f->record(0, region, strataCentre(*f, region, dark), 0.f);
+        }
+        f->endPass();
+        ASSERT_EQ(f->stratumOf(region, strataCentre(*f, region, bright)), bright);
+        if (std::string(smooth) == "0") {
+            EXPECT_EQ(at(bright), 100.f);
+            EXPECT_EQ(at(dark), 0.f);
+            EXPECT_EQ(at(sibling), 1e-3f);
+            EXPECT_EQ(at(far), 1e-3f);
+            continue;
+        }
+        // Prior 2: the root 800 / 16; each node on the way down (S + 2 parent) / (N + 2),
+        // with S, N = 800, 8 on the bright stratum's path and 0, 8 on the dark one's.
+        const double root = 800.0 / 16.0;
+        double up = root, down = root;
+        for (int level = 0; level < 3; ++level) {  // the 2x2, 4x4 and 8x8 nodes
+            up = (800.0 + 2.0 * up) / 10.0;
+            down = (0.0 + 2.0 * down) / 10.0;
+        }
+        EXPECT_NEAR(at(far), root, 1e-5 * root);
+        EXPECT_NEAR(at(sibling), up, 1e-5 * up);
+        EXPECT_NEAR(at(bright), (800.0 + 2.0 * up) / 10.0, 1e-5 * up);
+        EXPECT_NEAR(at(dark), (2.0 * down) / 10.0, 1e-5 * up);
+        EXPECT_GT(at(bright), at(sibling));
+        EXPECT_GT(at(sibling), at(far));
+        EXPECT_GT(at(far), 100.f * at(dark));
+        EXPECT_GT(f->pdf(region, strataCentre(*f, region, sibling)),
+                  f->pdf(region, strataCentre(*f, region, far)));
+        EXPECT_NEAR(strataIntegral(*f, region), 1.0, 1e-5);
+        chi2::Result exact = strataTest(*f, region, 700, 1000000);
+        EXPECT_TRUE(exact.passed) << exact.message;
+        chi2::SphereResult r = sphereTest(*f, region, 701, 100000);
+        EXPECT_TRUE(r.passed) << r.message;
+    }
+}
+
 TEST(HemiField, TrainedSamplingMatchesPdfAndFollowsLight) {
     auto f = makeHemi(planeScene(), {{"points", "16"}});
     ASSERT_TRUE(f);
@@ -403,7 +461,7 @@ TEST(HemiField, SampleReportsPdfOfItsDirection) {
 
 TEST(HemiField, RunningMeanConvergesToTargets) {
     auto f = makeHemi(planeScene(),
-                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}});
+                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}, {"smooth", "0"}});
     ASSERT_TRUE(f);
     const int region = 2, n = f->layout().count();
     std::mt19937_64 rng(31);
@@ -429,7 +487,7 @@ TEST(HemiField, RunningMeanConvergesToTargets) {
     }
     // Noise-free constant targets: Q equals T exactly after one pass.
     auto g = makeHemi(planeScene(),
-                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}});
+                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}, {"smooth", "0"}});
     ASSERT_TRUE(g);
     g->beginPass(1);
     double total = 0.0;
@@ -509,7 +567,8 @@ TEST(HemiField, RejectsBadTargetsAndRecords) {
 }
 
 TEST(HemiField, AllZeroRowFallsBackToUniform) {
-    auto f = makeHemi(planeScene(), {{"points", "1"}, {"strata", "2x2"}, {"epsilon", "0"}});
+    auto f = makeHemi(planeScene(),
+                      {{"points", "1"}, {"strata", "2x2"}, {"epsilon", "0"}, {"smooth", "0"}});
     ASSERT_TRUE(f);
     f->beginPass(1);
     for (int j = 0; j < 4; ++j) f->record(0, 0, strataCentre(*f, 0, j), 0.f);
