@@ -266,12 +266,14 @@ std::string HemiField::describe() const {
     char buf[512];
     std::snprintf(buf, sizeof(buf),
                   "hemi: %zu points (%d hemispheres, %llu draws), %dx%d strata, alpha=%s, "
-                  "normal-angle=%g, knn=%d, init=%g, epsilon=%g, %.1f MiB (+%.1f MiB record "
+                  "normal-angle=%g, knn=%d, init=%g, epsilon=%g, warmup=%g, smooth=%g, "
+                  "%.1f MiB (+%.1f MiB record "
                   "buffers); passes=%llu, records=%llu, rejected targets=%llu, "
                   "rejected records=%llu",
                   positions_.size(), numRegions(), (unsigned long long)attempts_, params_.cols,
                   params_.rows, alpha, params_.normalAngleDeg, params_.knn, params_.init,
-                  params_.epsilon, double(bytes()) / (1024.0 * 1024.0),
+                  params_.epsilon, params_.warmup, params_.smooth,
+                  double(bytes()) / (1024.0 * 1024.0),
                   double(scratchBytes()) / (1024.0 * 1024.0),
                   (unsigned long long)stats().passes, (unsigned long long)stats().records,
                   (unsigned long long)stats().rejectedTargets,

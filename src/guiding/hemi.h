@@ -27,9 +27,10 @@ struct HemiParams {
     // Strata in phi and in cos(theta). 16x16, not the paper's 8x8: a trained 16x16 guide
     // resolves the small bright patches that light indirectly lit scenes. Per sample with a
     // guide trained for 1024 spp (64 spp, seeds 2/3, relMSE): veach-bidir 0.116/0.110 (8x8)
-    // -> 0.062/0.062, breakfast 3.87/4.03 -> 3.20/2.78. At 30 s against none (pinned pairs,
-    // both core orders, docs/BENCHMARKS.md): veach-bidir 0.53 -> 0.39, breakfast 0.58 ->
-    // 0.48, killeroo 1.10 -> 1.04, cornell-box 1.07 -> 1.10, conference-room 1.08 -> 1.17.
+    // -> 0.062/0.062, breakfast 3.87/4.03 -> 3.20/2.78. At 30 s against none with warmup 8
+    // and smooth 2 (pinned pairs, both core orders, docs/BENCHMARKS.md): veach-bidir 0.53 ->
+    // 0.40, breakfast 0.58 -> 0.51, metal-spheres 1.11 -> 1.02, cornell-box 1.07 -> 1.08,
+    // killeroo 1.10 -> 1.12, conference-room 1.08 -> 1.12.
     int cols = 16, rows = 16;
     // Surface samples (two hemispheres each). Fewer regions learn faster: measured relMSE
     // (64 spp, seeds 2/3/4) veach-bidir 0.255/0.307/0.279 with 8192 points against
@@ -70,9 +71,9 @@ struct HemiParams {
     // default samples=sequence (docs/STABILITY.md): an unvisited stratum no longer looks
     // dark, so the samples a pixel's sequence places where its earlier samples did not go do
     // not meet a policy that learned to avoid those directions. White furnace, 64 spp, seeds
-    // 1-4, mean against 1: 16x16 strata, warmup 8: +0.025% to +0.074% -> -0.007% to +0.005%;
-    // 8x8, warmup 16: +0.008% to +0.019% -> -0.001% to +0.012%. At equal time (30 s) it is
-    // within the noise of the runs (docs/BENCHMARKS.md).
+    // 1-4, image mean against the exact value: 16x16 strata, warmup 8: +0.049% to +0.074% ->
+    // -0.007% to +0.005%; 8x8, warmup 16: +0.016% to +0.037% -> -0.001% to +0.012%. At equal
+    // time (30 s) it is within the noise of the runs (docs/BENCHMARKS.md).
     double smooth = 2.0;
 };
 
