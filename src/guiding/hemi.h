@@ -52,9 +52,10 @@ struct HemiParams {
     // 64 spp with 8x8 strata (relMSE; none: 0.331, 6.95, 0.0176): warmup 1 -> veach-bidir
     // 0.345, breakfast 4.46, buddha-fractal 0.0215; 8 -> 0.266, 5.42, 0.0208; 16 -> 0.251,
     // 5.75, 0.0202. With 16x16 strata, 8 (2048 records per region for confidence 1/2; 1024 at
-    // 8x8 and 16): at 30 s against none veach-bidir 0.42 / 0.39 / 0.47 with warmup 4 / 8 /
-    // 16, breakfast 0.56 / 0.48 / 0.53, cornell-box 1.10 / 1.10 / 1.17, killeroo 1.19 / 1.04
-    // / 1.09 (three runs at different times of day: the machine's speed varied by 20%).
+    // 8x8 and 16): at 30 s against none veach-bidir 0.42 / 0.39 / 0.47 with warmup 4 (and
+    // smooth 2) / 8 / 16 (both without), breakfast 0.56 / 0.48 / 0.53, cornell-box 1.10 /
+    // 1.10 / 1.17, killeroo 1.19 / 1.04 / 1.09 (three runs at different times of day: the
+    // machine's speed varied by 20%).
     double warmup = 8.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
