@@ -36,6 +36,19 @@ std::vector<std::vector<uint32_t>> StrataLayout::quadtree() const {
     return levels;
 }
 
+std::vector<std::vector<uint32_t>> StrataLayout::sphereQuadtree() const {
+    std::vector<std::vector<uint32_t>> levels = quadtree();
+    for (std::vector<uint32_t>& map : levels) {
+        uint32_t parents = 0;
+        for (uint32_t p : map) parents = std::max(parents, p + 1);
+        const size_t n = map.size();
+        map.resize(2 * n);
+        for (size_t i = 0; i < n; ++i) map[n + i] = map[i] + parents;
+    }
+    levels.push_back({0u, 0u});
+    return levels;
+}
+
 void buildStrataCdf(const double* q, int n, double epsilon, float* cdf) {
     double sum = 0.0;
     for (int j = 0; j < n; ++j) sum += q[j];

@@ -140,6 +140,10 @@ public:
     // a grid of ceil(cols / 2) x ceil(rows / 2), each next level halves that grid likewise, and
     // the last level maps to the single root (node indices row-major in their grid).
     std::vector<std::vector<uint32_t>> quadtree() const;
+    // The same for the full sphere's 2 count() strata (sphereStratumOf): a quadtree per
+    // hemisphere (the lower one's nodes numbered after the upper one's), then one last level
+    // joining the two hemisphere roots.
+    std::vector<std::vector<uint32_t>> sphereQuadtree() const;
 
     // Local unit direction of stratum j's centre (its representative direction).
     const glm::vec3& centre(int j) const { return centres_[static_cast<size_t>(j)]; }

@@ -128,6 +128,9 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
     } else if (key == "cosine") {
         if (value != "0" && value != "1") return bad("0 or 1");
         p->cosine = value == "1";
+    } else if (key == "smooth") {
+        if (!parseDouble(value, &d) || d < 0.0 || d > 1e9) return bad("a number in [0, 1e9]");
+        p->smooth = d;
     } else if (key == "max-mb") {
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
         *maxMiB = d;
@@ -161,11 +164,6 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (value != "cell" && value != "exact")
                 return badValue("hemi", key, value, "cell or exact", error);
             hp->cellLookup = value == "cell";
-        } else if (key == "smooth") {
-            double d = 0.0;
-            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
-                return badValue("hemi", key, value, "a number in [0, 1e9]", error);
-            hp->smooth = d;
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
@@ -219,8 +217,8 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
         } else {
             *error = "guiding backend 'vdb': unknown parameter '" + key +
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
-                     "normal-angle, init, epsilon, cosine, warmup, volume, volume-voxel, "
-                     "max-mb, mix, target, samples, auto, rr)";
+                     "normal-angle, init, epsilon, cosine, warmup, smooth, volume, "
+                     "volume-voxel, max-mb, mix, target, samples, auto, rr)";
             return false;
         }
     }

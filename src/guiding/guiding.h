@@ -171,8 +171,8 @@ public:
 //   warmup       records per stratum until a region's policy gets the full mixture weight:
 //                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 8 for
 //                hemi, 16 for vdb; 0 = always full weight, the paper's behaviour)
-//   smooth       hemi: prior strength, in visits, of the hierarchical smoothing of the
-//                strata estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
+//   smooth       prior strength, in visits, of the hierarchical smoothing of the strata
+//                estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
 //   mix, target, samples, auto
@@ -183,7 +183,7 @@ public:
 //                record selection samples, from which every backend learns selection() per
 //                region)
 // Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.
-// Parameters alpha, strata, init, epsilon, cosine, max-mb, mix, target as hemi, and
+// Parameters alpha, strata, init, epsilon, cosine, smooth, max-mb, mix, target as hemi, and
 //   voxel        N: N voxels along the longest axis of the scene bounds, 1..4096
 //   voxel-size   the voxel edge in world units, > 0 (not with voxel)
 //                (default for both: the edge that gives about 1024 voxels' worth of surface,

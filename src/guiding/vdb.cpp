@@ -184,6 +184,9 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     }
     grid_->grid = grid;
     buildFrames();
+    if (params_.smooth > 0.0)
+        table_.setSmoothing(params_.sphere ? layout_.sphereQuadtree() : layout_.quadtree(),
+                            params_.smooth, params_.init);
     table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
                  layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
     resetConfidence();
@@ -193,6 +196,7 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
         vp.cols = params_.cols;
         vp.rows = params_.rows;
         vp.init = params_.init;
+        vp.smooth = params_.smooth;
         vp.epsilon = params_.epsilon;
         vp.warmup = params_.warmup;
         vp.alphaVisits = params_.alphaVisits;
@@ -409,7 +413,7 @@ float VdbField::scatteredEstimate(int region,
                                   const std::function<float(const glm::vec3&)>& fcos) const {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->scatteredEstimate(cell, fcos);
     if (!validRegion(region)) return 0.f;
-    const double* q = table_.q(size_t(region));
+    const float* q = table_.estimates(size_t(region));
     double acc = 0.0;
     for (int j = 0; j < table_.strata(); ++j) {
         float f = fcos(strataCentre(region, j));
@@ -437,9 +441,8 @@ float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
 
 float VdbField::radiance(int region, const glm::vec3& w) const {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->radiance(cell, w);
-    int j = stratumOf(region, w);
-    if (j < 0) return 0.f;
-    return static_cast<float>(std::min(table_.q(size_t(region))[j], double(FLT_MAX)));
+    const int j = stratumOf(region, w);
+    return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
 float VdbField::selection(int region) const {

@@ -27,6 +27,8 @@ VdbVolume::VdbVolume(const VolumeParams& params, const glm::vec3& boundsMin,
     for (int a = 0; a < 3; ++a)
         dims_[a] = std::clamp(int(std::ceil(double(extent[a]) / voxelSize_)), 1, 4096);
     grid_->grid = openvdb::Int32Grid::create(-1);
+    if (params_.smooth > 0.0)
+        table_.setSmoothing(layout_.sphereQuadtree(), params_.smooth, params_.init);
     table_.reset(0, 2 * layout_.count(), params_.init, policy());
 }
 
@@ -96,7 +98,7 @@ float VdbVolume::radiance(int cell, const glm::vec3& w) const {
 float VdbVolume::scatteredEstimate(int cell,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (cell < 0 || cell >= cells()) return 0.f;
-    const double* q = table_.q(size_t(cell));
+    const float* q = table_.estimates(size_t(cell));
     double acc = 0.0;
     for (int j = 0, n = table_.strata(); j < n; ++j) {
         const float f = fcos(layout_.sphereCentre(j));

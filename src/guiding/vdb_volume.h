@@ -29,6 +29,7 @@ struct VolumeParams {
     double init = 1e-3;
     double epsilon = 0.1;
     double warmup = 16.0;
+    double smooth = 0.0;  // StrataTable::setSmoothing's prior over the sphere quadtree; 0: off
     bool alphaVisits = true;
     double fixedAlpha = 1.0;
     uint64_t maxVoxels = uint64_t(1) << 20;  // activation stops here (memory cap)

@@ -86,10 +86,10 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"none", "hemi", "vdb"}));
     app.add_option("--guide-param", guideParams,
                    "guiding parameter key=value (repeatable): mix (0..1 or learn), alpha, "
-                   "strata (WxH), points, normal-angle, init, epsilon, cosine, max-mb, "
+                   "strata (WxH), points, normal-angle, init, epsilon, cosine, smooth, max-mb, "
                    "target (path, sample or sum), rr (adjoint or pbrt), samples, auto (N "
-                   "spp: a guided-or-plain trial; default off); hemi: knn, warmup, smooth, "
-                   "lookup (cell or exact); vdb: "
+                   "spp: a guided-or-plain trial; default off); hemi: knn, warmup, lookup "
+                   "(cell or exact); vdb: "
                    "voxel, voxel-size, dirs, normals, warmup, volume, volume-voxel "
                    "(README.md)");
     app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering");

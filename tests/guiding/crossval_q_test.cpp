@@ -49,7 +49,7 @@ struct Cell {
 TEST(GuideCrossValidation, HemiAndVdbLearnTheSameQ) {
     // (smooth=0: radiance() is then Q itself, the running mean compared below)
     auto hemi = make("hemi", {{"points", "16"}, {"strata", "4x4"}, {"smooth", "0"}});
-    auto vdb = make("vdb", {{"voxel", "4"}, {"strata", "4x4"}});
+    auto vdb = make("vdb", {{"voxel", "4"}, {"strata", "4x4"}, {"smooth", "0"}});
     ASSERT_TRUE(hemi && vdb);
     auto* h = dynamic_cast<HemiField*>(hemi.get());
     auto* v = dynamic_cast<VdbField*>(vdb.get());

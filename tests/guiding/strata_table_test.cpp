@@ -40,6 +40,20 @@ TEST(StrataLayout, QuadtreeHalvesTheGridUpToOneRoot) {
     EXPECT_EQ(one[0], std::vector<uint32_t>{0u});
 }
 
+TEST(StrataLayout, SphereQuadtreeJoinsTheTwoHemispheres) {
+    const auto levels = StrataLayout(4, 2).sphereQuadtree();
+    // Per hemisphere 4x2 -> 2x1 -> 1; then the two hemisphere roots -> 1.
+    ASSERT_EQ(levels.size(), 3u);
+    EXPECT_EQ(levels[0].size(), 16u);
+    EXPECT_EQ(levels[1].size(), 4u);
+    EXPECT_EQ(levels[2], (std::vector<uint32_t>{0u, 0u}));
+    EXPECT_EQ(levels[0][0], 0u);   // upper (0, 0) -> upper node 0
+    EXPECT_EQ(levels[0][7], 1u);   // upper (1, 3) -> upper node (0, 1)
+    EXPECT_EQ(levels[0][8], 2u);   // lower (0, 0) -> lower node 0, numbered after the upper 2
+    EXPECT_EQ(levels[0][15], 3u);  // lower (1, 3) -> lower node (0, 1)
+    EXPECT_EQ(levels[1], (std::vector<uint32_t>{0u, 0u, 1u, 1u}));
+}
+
 // One region of 4x4 strata, one pass of records: per entry of `records`, `count` targets of
 // `target` in stratum `stratum`. Returns the region's estimates and checks that the policy
 // was built from them.

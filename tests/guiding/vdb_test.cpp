@@ -335,6 +335,30 @@ TEST(VdbField, TrainedSamplingMatchesPdfAndFollowsLight) {
     }
 }
 
+// smooth=K (2 by default): one stratum's records spread to the unvisited strata
+// (the root's mean, here the one target value: every estimate is 100 after one pass), for
+// hemisphere and full-sphere tables; the policy stays exact. Without it they keep init.
+TEST(VdbField, SmoothingSpreadsSparseVisitsAndKeepsThePdfExact) {
+    for (const char* dirs : {"hemi", "sphere"}) {
+        for (const char* smooth : {"0", "2"}) {
+            auto f = makeVdb(planeScene(), {{"voxel", "4"}, {"dirs", dirs}, {"smooth", smooth}});
+            ASSERT_TRUE(f);
+            const int region = 2;
+            const glm::vec3 bright = f->strataCentre(region, 5);
+            f->beginPass(1);
+            for (int i = 0; i < 8; ++i) f->record(0, region, bright, 100.f);
+            f->endPass();
+            const glm::vec3 other = f->strataCentre(region, f->strataPerRegion() - 1);
+            EXPECT_EQ(f->radiance(region, bright), 100.f) << dirs;
+            EXPECT_FLOAT_EQ(f->radiance(region, other), smooth[0] == '0' ? 1e-3f : 100.f)
+                << dirs << " smooth " << smooth;
+            EXPECT_NEAR(strataIntegral(*f, region), 1.0, 1e-5) << dirs;
+            chi2::Result exact = strataTest(*f, region, 800, 400000);
+            EXPECT_TRUE(exact.passed) << dirs << " smooth " << smooth << ": " << exact.message;
+        }
+    }
+}
+
 TEST(VdbField, SampleReportsPdfOfItsDirection) {
     for (const char* dirs : {"hemi", "sphere"}) {
         auto f = makeVdb(cornerScene(), {{"voxel", "4"}, {"strata", "32x16"}, {"dirs", dirs}});
