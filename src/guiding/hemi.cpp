@@ -83,7 +83,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     frames_.resize(regions);
     for (size_t r = 0; r < regions; ++r) frames_[r].frame = HemiFrame::fromZ(regionNormal(int(r)));
     if (params.smooth > 0.0)
-        table_.setSmoothing(layout_.quadtree(), params.smooth, params.init);
+        table_.setSmoothing(layout_.quadtree(), params.smooth);
     table_.reset(regions, strata_, params.init, policy());
     // (reset built region 0 and copied it to the others)
     if (regions > 0) {

@@ -14,6 +14,7 @@ namespace rlpbrt::guiding {
 void StrataTable::reset(size_t regions, int strata, double init, const PolicyBuilder& policy) {
     regions_ = regions;
     strata_ = strata;
+    init_ = init;
     const size_t n = size_t(strata);
     q_.assign(regions * n, init);
     est_.assign(regions * n, float(std::min(init, double(FLT_MAX))));
@@ -51,12 +52,10 @@ void StrataTable::assign(std::vector<double> q, std::vector<uint64_t> visits,
     for (size_t r = 0; r < regions_; ++r) rebuild(r, policy);
 }
 
-void StrataTable::setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior,
-                               double init) {
+void StrataTable::setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior) {
     levels_.clear();
     levelSize_.clear();
     prior_ = prior > 0.0 && std::isfinite(prior) ? prior : 0.0;
-    smoothInit_ = init;
     if (prior_ == 0.0) return;
     levels_ = std::move(levels);
     for (const std::vector<uint32_t>& map : levels_) {
@@ -97,7 +96,7 @@ void StrataTable::estimate(size_t region, double* out) const {
         for (size_t i = 0; i < levelSize_[l]; ++i) {
             const size_t node = offset[l] + i;
             if (l + 1 == levels) {
-                est[node] = count[node] > 0.0 ? sum[node] / count[node] : smoothInit_;
+                est[node] = count[node] > 0.0 ? sum[node] / count[node] : init_;
                 continue;
             }
             const double parent = est[offset[l + 1] + levels_[l + 1][i]];

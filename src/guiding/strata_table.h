@@ -43,12 +43,12 @@ public:
     // of level 1 that holds stratum j, levels[1][i] = the parent of that node, ..., the last
     // level has a single node, the root). A node's estimate is (S + prior * parent's estimate)
     // / (N + prior), with N the visits under it and S the sum of their targets (visits x Q
-    // for a stratum); the root's is S / N (`init` while N = 0). A stratum with few visits thus
+    // for a stratum); the root's is S / N (reset()'s `init` while N = 0). A stratum with few visits thus
     // borrows its coarser neighbourhood's mean, one with many keeps its own Q, and a stratum
     // without visits is not taken for dark (which removes the bias of guided passes that
     // continue each pixel's sequence, docs/STABILITY.md). prior 0 or no levels: the
     // estimates are Q. Call before reset()/grow()/assign() build the policy.
-    void setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior, double init);
+    void setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior);
     // The (unrounded) estimates of one region, strata doubles.
     void estimate(size_t region, double* out) const;
     const uint64_t* visits(size_t region) const { return &visits_[region * size_t(strata_)]; }
@@ -132,7 +132,8 @@ private:
     std::vector<float> est_;
     std::vector<std::vector<uint32_t>> levels_;  // setSmoothing's tree (empty: none)
     std::vector<uint32_t> levelSize_;            // nodes per level above the strata
-    double prior_ = 0.0, smoothInit_ = 0.0;
+    double prior_ = 0.0;
+    double init_ = 0.0;  // reset()'s initial Q
     std::vector<uint64_t> visits_;
     std::vector<float> cdf_;
     std::vector<SlotBuffer> slots_;

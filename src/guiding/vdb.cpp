@@ -186,7 +186,7 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     buildFrames();
     if (params_.smooth > 0.0)
         table_.setSmoothing(params_.sphere ? layout_.sphereQuadtree() : layout_.quadtree(),
-                            params_.smooth, params_.init);
+                            params_.smooth);
     table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
                  layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
     resetConfidence();

@@ -28,7 +28,7 @@ VdbVolume::VdbVolume(const VolumeParams& params, const glm::vec3& boundsMin,
         dims_[a] = std::clamp(int(std::ceil(double(extent[a]) / voxelSize_)), 1, 4096);
     grid_->grid = openvdb::Int32Grid::create(-1);
     if (params_.smooth > 0.0)
-        table_.setSmoothing(layout_.sphereQuadtree(), params_.smooth, params_.init);
+        table_.setSmoothing(layout_.sphereQuadtree(), params_.smooth);
     table_.reset(0, 2 * layout_.count(), params_.init, policy());
 }
 

@@ -63,7 +63,7 @@ struct Records {
 };
 std::vector<double> trainOnce(double prior, const std::vector<Records>& records) {
     StrataTable table;
-    if (prior > 0.0) table.setSmoothing(StrataLayout(4, 4).quadtree(), prior, 1e-3);
+    if (prior > 0.0) table.setSmoothing(StrataLayout(4, 4).quadtree(), prior);
     std::vector<double> fromPolicy;
     auto policy = [&](int, const double* q, float* cdf) {
         fromPolicy.assign(q, q + 16);
@@ -108,7 +108,7 @@ TEST(StrataTable, SmoothingShrinksTowardsTheCoarserMeans) {
 
 TEST(StrataTable, TheRootIsInitOnlyBeforeAnyVisit) {
     StrataTable table;
-    table.setSmoothing(StrataLayout(4, 4).quadtree(), 2.0, 0.25);
+    table.setSmoothing(StrataLayout(4, 4).quadtree(), 2.0);
     table.reset(1, 16, 0.25, [](int, const double* q, float* cdf) {
         buildStrataCdf(q, 16, 0.1, cdf);
     });
