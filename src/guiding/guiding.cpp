@@ -135,7 +135,7 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
         *maxMiB = d;
     } else if (key == "mix" || key == "target" || key == "samples" || key == "auto" ||
-               key == "rr") {
+               key == "rr" || key == "rr-window") {
         // Consumed by the integrator and the render loop.
     } else {
         return 0;

@@ -83,6 +83,16 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
         }
         settings->adjointRoulette = rr->second == "adjoint";
     }
+    auto window = config.params.find("rr-window");
+    if (window != config.params.end()) {
+        char* end = nullptr;
+        const float w = std::strtof(window->second.c_str(), &end);
+        if (end == window->second.c_str() || *end != '\0' || !(w > 0.f && w <= 1.f)) {
+            *error = "rr-window must be a number in (0, 1], got \"" + window->second + "\"";
+            return false;
+        }
+        settings->rouletteWindow = w;
+    }
     auto autoSpp = config.params.find("auto");
     if (autoSpp != config.params.end()) {
         char* end = nullptr;
@@ -147,12 +157,10 @@ struct SelectionVertex {
 };
 constexpr int kMaxSelectionVertices = 16;
 
-// Adjoint-driven roulette (GuideSettings::adjointRoulette): the lower edge of the weight
-// window as a share of the pixel estimate, the least survival probability (bounds a
-// survivor's weight), and the confidence a region needs before its Q is trusted. Window
-// measured on cornell-box (64 spp, seeds 2/3; relMSE, mean path length; pbrt's roulette:
-// 0.000744, 3.71): 0.3 -> 0.000654, 3.83; 0.1 -> 0.000620, 4.03; 0.03 -> 0.000605, 4.42.
-constexpr float kRouletteWindow = 0.1f;
+// Adjoint-driven roulette (GuideSettings::adjointRoulette): the first bounce it may end a
+// path at, the least survival probability (bounds a survivor's weight), and the confidence a
+// region needs before its Q is trusted.
+constexpr int kRouletteFirstBounce = 1;
 constexpr float kMinSurvival = 0.25f;
 constexpr float kRouletteConfidence = 0.5f;
 
@@ -596,11 +604,12 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         ray.d = ds.wi;
         ray.tMax = Infinity;
         if (!isFinite(beta)) break;
-        // After bounce 3: roulette on the expected contribution where the guide knows it.
-        if (guide_.adjointRoulette && bounces > 3 && pixelEstimate > 0.f && sampleRegion >= 0 &&
-            !ds.transmission && field->confidence(sampleRegion) >= kRouletteConfidence) {
+        // From the second vertex on: roulette on the expected contribution where the guide
+        // knows it.
+        if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
+            sampleRegion >= 0 && !ds.transmission && field->confidence(sampleRegion) >= kRouletteConfidence) {
             const float expected = luminance(beta) * field->radiance(sampleRegion, ds.wi);
-            const float low = kRouletteWindow * pixelEstimate;
+            const float low = guide_.rouletteWindow * pixelEstimate;
             if (expected < low) {
                 const float survive = std::max(expected / low, kMinSurvival);
                 if (sampler.get1D() >= survive) break;

@@ -77,19 +77,23 @@ struct GuideSettings {
     // 0.74-1.05 on conference, killeroo, cornell-box and veach-mis, which lose 1.16-1.37x at
     // 30 s, and 2.3 on breakfast, which wins 0.78x (docs/BENCHMARKS.md); not the default.
     int autoSpp = 0;
-    // rr=adjoint: after bounce 3, where pbrt-v3 plays Russian roulette on the throughput,
-    // guided surface vertices play it on the path's expected remaining contribution,
-    // throughput x the learned Q of the sampled direction, against the pixel's estimate from
-    // earlier passes (Vorba and Krivanek 2016, without splitting): below kRouletteWindow of
-    // it the path survives with the ratio (at least kMinSurvival). The throughput alone is
-    // low exactly where the guide chose a bright direction. Untrained regions and pixels
-    // without an estimate keep pbrt-v3's roulette. rr=pbrt: pbrt-v3's everywhere.
-    // Only paths longer than 4 vertices meet it: of the reference scenes, cornell-box
-    // (maxdepth 65; relMSE at 64 spp 0.000744 -> 0.000620, 3.71 -> 4.03 vertices per path;
-    // at 30 s, one thread, against none: 1.17 -> 1.10 / 1.05 with the cores swapped).
+    // rr=adjoint: from the second surface vertex on, guided surface vertices play Russian
+    // roulette on the path's expected remaining contribution, throughput x the learned Q of
+    // the sampled direction, against the pixel's estimate from earlier passes (Vorba and
+    // Krivanek 2016, without splitting): below rouletteWindow of it the path survives with
+    // the ratio (at least kMinSurvival). The throughput alone is low exactly where the guide
+    // chose a bright direction. Untrained regions and pixels without an estimate keep
+    // pbrt-v3's roulette (after bounce 3). rr=pbrt: pbrt-v3's everywhere.
+    // Per sample it costs some variance (killeroo, 64 spp: relMSE 0.000313 -> 0.000329 when
+    // it starts at the second vertex instead of after bounce 3) and saves more time (5.9 ->
+    // 5.2 s); at 30 s against none it took breakfast 0.51 -> 0.40, conference-room 1.12 ->
+    // 0.96, killeroo 1.12 -> 1.05, cornell-box 1.08 -> 1.04 (docs/BENCHMARKS.md, session 9).
+    // Starting at the first vertex lost per time on killeroo (0.000406 at 4.7 s).
     // Like the policy, the estimate comes from earlier samples of the same pixels
     // (GuideSettings::independentPasses).
     bool adjointRoulette = true;
+    // rr-window: the weight window's lower edge as a share of the pixel estimate.
+    float rouletteWindow = 0.1f;
 };
 
 class Rng;

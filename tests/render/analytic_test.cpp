@@ -368,15 +368,34 @@ const Extreme kExtremes[] = {
 INSTANTIATE_TEST_SUITE_P(Hemi, GuideExtremes, ::testing::ValuesIn(kExtremes),
                          [](const auto& info) { return std::string(info.param.name); });
 
-// rr=adjoint plays Russian roulette after bounce 3 on the expected contribution (throughput x
-// learned Q against the pixel's estimate). In an emitting enclosure with 12 bounces it runs on
-// most deep vertices; the answer must not move, and the image must differ from pbrt-v3's
-// roulette (the adjoint one ran).
+// rr=adjoint plays Russian roulette from the second vertex on, on the expected contribution
+// (throughput x learned Q against the pixel's estimate). In an emitting enclosure with 12
+// bounces it runs on most vertices; the answer must not move, and the image must differ from
+// pbrt-v3's roulette (the adjoint one ran).
 TEST(AdjointRoulette, EnclosureStaysExact) {
     const std::string scene = enclosure(0.5, 1.0, 12);
     for (const char* backend : {"hemi", "vdb"}) {
         Rendered adjoint = renderText(scene, backend, {{"rr", "adjoint"}, {"warmup", "0"}});
         expectMean(adjoint, series(0.5, 1.0, 12), std::string(backend) + " rr=adjoint");
+        Rendered plain = renderText(scene, backend, {{"rr", "pbrt"}, {"warmup", "0"}});
+        ASSERT_TRUE(plain.ok);
+        ASSERT_TRUE(adjoint.ok);
+        double diff = 0.0;
+        for (size_t i = 0; i < plain.image.pixels.size(); ++i)
+            diff += std::abs(double(plain.image.pixels[i]) - double(adjoint.image.pixels[i]));
+        EXPECT_GT(diff, 0.0) << backend;
+    }
+}
+
+// Where pbrt-v3 never plays roulette (3 bounces: it starts after bounce 3), the adjoint one
+// does, from the second vertex on; with the widest window (1: every path whose expected
+// remainder is below its pixel's estimate is at risk) the answer must not move either.
+TEST(AdjointRoulette, ShallowPathsStayExact) {
+    const std::string scene = enclosure(0.5, 1.0, 3);
+    for (const char* backend : {"hemi", "vdb"}) {
+        Rendered adjoint = renderText(scene, backend,
+                                      {{"rr", "adjoint"}, {"rr-window", "1"}, {"warmup", "0"}});
+        expectMean(adjoint, series(0.5, 1.0, 3), std::string(backend) + " rr-window=1");
         Rendered plain = renderText(scene, backend, {{"rr", "pbrt"}, {"warmup", "0"}});
         ASSERT_TRUE(plain.ok);
         ASSERT_TRUE(adjoint.ok);

@@ -136,10 +136,14 @@ TEST(GuideCrossValidation, IntegratorParametersAreValidated) {
     EXPECT_FALSE(gs.adjointRoulette);
     ASSERT_TRUE(setup({{"rr", "adjoint"}}, &gs, &err)) << err;
     EXPECT_TRUE(gs.adjointRoulette);
+    EXPECT_FLOAT_EQ(gs.rouletteWindow, 0.1f);  // the default
+    ASSERT_TRUE(setup({{"rr-window", "0.25"}}, &gs, &err)) << err;
+    EXPECT_FLOAT_EQ(gs.rouletteWindow, 0.25f);
     for (const auto& bad : std::vector<std::map<std::string, std::string>>{
              {{"mix", "learnt"}}, {{"mix", "1.5"}}, {{"samples", "random"}},
              {{"target", "all"}}, {{"auto", "-1"}}, {{"auto", "16x"}}, {{"auto", ""}},
-             {{"rr", "russian"}}}) {
+             {{"rr", "russian"}}, {{"rr-window", "0"}}, {{"rr-window", "1.5"}},
+             {{"rr-window", "wide"}}}) {
         err.clear();
         EXPECT_FALSE(setup(bad, &gs, &err)) << bad.begin()->first;
         EXPECT_NE(err.find(bad.begin()->first), std::string::npos) << err;
