@@ -89,10 +89,14 @@ public:
     // Samples a unit world direction from the frozen policy of `region` (u places it inside
     // the stratum chosen by uStratum; all in [0,1)); *pdf is per steradian and equals
     // pdf(region, result) (> 0 for a valid region; 0 and a zero vector for an invalid one).
-    virtual glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const = 0;
+    // *bin (if given) receives the result's bin, as pdf() does.
+    virtual glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
+                             int* bin = nullptr) const = 0;
     // Solid-angle pdf of sample() for any world direction (0 outside the region's hemisphere
-    // and for an invalid region); w need not be normalised.
-    virtual float pdf(int region, const glm::vec3& w) const = 0;
+    // and for an invalid region); w need not be normalised. *bin (if given) receives w's bin
+    // in the region (its stratum; -1 outside): a token that record() and radiance() accept
+    // for the same region and w instead of finding the bin again.
+    virtual float pdf(int region, const glm::vec3& w, int* bin = nullptr) const = 0;
     // The bootstrap part of Eq. 1 at a region y: (2pi/n) * sum_j Q(y,j) * fcos(w_j), where
     // fcos(world dir) returns f_s(w_j, y, -w) * max(0, cos) as a scalar (luminance). w_j are
     // the unit world directions of the stratum centres. Non-finite or negative fcos values
@@ -107,7 +111,8 @@ public:
     virtual float irradianceEstimate(int region, const glm::vec3& n) const;
     // The learned incident radiance Q(region, stratum of w) (0 for an invalid region or a
     // direction outside the region's hemisphere): for one-sample estimates of the Eq. 1 sum.
-    virtual float radiance(int region, const glm::vec3& w) const = 0;
+    // bin: w's bin from pdf()/sample() for this region, or -1 (found from w).
+    virtual float radiance(int region, const glm::vec3& w, int bin = -1) const = 0;
 
     // How far the policy of `region` is trusted, in [0, 1] (0 for an invalid region): the
     // integrator multiplies its guide/BSDF mixture probability by it, so regions with little
@@ -129,8 +134,10 @@ public:
     // order at endPass() so results do not depend on thread scheduling. Thread-safe across
     // slots; one thread at a time per slot.
     virtual void beginPass(int numSlots) = 0;
-    // Records one target (radiance, luminance); rejected if not finite or negative.
-    virtual void record(int slot, int region, const glm::vec3& w, float target) = 0;
+    // Records one target (radiance, luminance); rejected if not finite or negative. bin: w's
+    // bin from pdf()/sample() for this region, or -1 (found from w).
+    virtual void record(int slot, int region, const glm::vec3& w, float target,
+                        int bin = -1) = 0;
     // Applies the recorded targets (Eq. 1 with alpha = 1/(1+visits) by default, i.e. the
     // batch running mean of the notes section 4, or a fixed alpha) and rebuilds the CDFs.
     virtual void endPass() = 0;
@@ -175,11 +182,12 @@ public:
 //                estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
-//   mix, target, samples, auto
+//   mix, target, samples, auto, rr, rr-window
 //                consumed by the integrator and the render loop; accepted and ignored here
 //                ("target=path|sample|sum": train on the path's returns, the default, or
 //                on Eq. 1's bootstrap; "samples=independent": a sample set per pass;
-//                "auto=N": the guided-or-plain trial; "mix=learn" makes the integrator
+//                "auto=N": the guided-or-plain trial; "rr=adjoint|pbrt" and "rr-window=w":
+//                the integrator's roulette; "mix=learn" makes the integrator
 //                record selection samples, from which every backend learns selection() per
 //                region)
 // Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.

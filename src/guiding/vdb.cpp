@@ -381,15 +381,21 @@ glm::vec3 VdbField::strataCentre(int region, int j) const {
     return frames_[size_t(region)].toWorld(glm::vec3(centreX_[k], centreY_[k], centreZ_[k]));
 }
 
-float VdbField::pdf(int region, const glm::vec3& w) const {
-    if (const int cell = volumeCell(region); cell >= 0) return volume_->pdf(cell, w);
-    int j = stratumOf(region, w);
+float VdbField::pdf(int region, const glm::vec3& w, int* bin) const {
+    if (const int cell = volumeCell(region); cell >= 0) {
+        if (bin) *bin = -1;  // the volume tables find their bin again
+        return volume_->pdf(cell, w);
+    }
+    const int j = stratumOf(region, w);
+    if (bin) *bin = j;
     if (j < 0) return 0.f;
     return strataProbability(table_.cdf(size_t(region)), j) *
            static_cast<float>(layout_.count() / (2.0 * kPi));
 }
 
-glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut) const {
+glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut,
+                           int* bin) const {
+    if (bin) *bin = -1;
     if (const int cell = volumeCell(region); cell >= 0)
         return volume_->sample(cell, u, uStratum, pdfOut);
     if (!validRegion(region)) {
@@ -403,7 +409,7 @@ glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOu
     glm::vec3 w = glm::normalize(frames_[size_t(region)].toWorld(local));
     // Report exactly pdf(region, w) (rounding may move w across a stratum edge); on the
     // hemisphere's rim (pdf 0) keep the drawn stratum's density, as hemi does.
-    float p = pdf(region, w);
+    float p = pdf(region, w, bin);
     if (!(p > 0.f)) p = strataProbability(c, j) * static_cast<float>(n / (2.0 * kPi));
     *pdfOut = p;
     return w;
@@ -439,9 +445,10 @@ float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
         std::min(double(acc) * layout_.stratumSolidAngle(), double(FLT_MAX)));
 }
 
-float VdbField::radiance(int region, const glm::vec3& w) const {
+float VdbField::radiance(int region, const glm::vec3& w, int bin) const {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->radiance(cell, w);
-    const int j = stratumOf(region, w);
+    const int j =
+        validRegion(region) && bin >= 0 && bin < table_.strata() ? bin : stratumOf(region, w);
     return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
@@ -462,9 +469,12 @@ void VdbField::beginPass(int numSlots) {
     if (volume_) volume_->beginPass(numSlots);
 }
 
-void VdbField::record(int slot, int region, const glm::vec3& w, float target) {
+void VdbField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->record(slot, cell, w, target);
-    table_.record(slot, region, target, [&] { return stratumOf(region, w); });
+    table_.record(slot, region, target, [&] {
+        return validRegion(region) && bin >= 0 && bin < table_.strata() ? bin
+                                                                         : stratumOf(region, w);
+    });
 }
 
 void VdbField::endPass() {

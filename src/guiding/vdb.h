@@ -63,17 +63,19 @@ public:
     int lookup(const glm::vec3& p, const glm::vec3& n) const override;
     int lookupMedium(const glm::vec3& p) const override;
     void requestMedium(int slot, const glm::vec3& p) override;
-    glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf) const override;
-    float pdf(int region, const glm::vec3& w) const override;
+    glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
+                     int* bin = nullptr) const override;
+    float pdf(int region, const glm::vec3& w, int* bin = nullptr) const override;
     float scatteredEstimate(int region,
                             const std::function<float(const glm::vec3&)>& fcos) const override;
     float irradianceEstimate(int region, const glm::vec3& n) const override;
-    float radiance(int region, const glm::vec3& w) const override;
+    float radiance(int region, const glm::vec3& w, int bin = -1) const override;
     float confidence(int region) const override;
     float selection(int region) const override;
     void recordSelection(int slot, int region, const SelectionSample& s) override;
     void beginPass(int numSlots) override;
-    void record(int slot, int region, const glm::vec3& w, float target) override;
+    void record(int slot, int region, const glm::vec3& w, float target,
+                int bin = -1) override;
     void endPass() override;
     size_t bytes() const override;
     std::string describe() const override;

@@ -170,6 +170,7 @@ constexpr float kRouletteConfidence = 0.5f;
 // carries its MIS weight against the vertex's next-event estimation.
 struct ReturnVertex {
     int region;
+    int bin;  // the guide's bin of w in region, or -1
     Vec3 w;
     Spectrum L;     // L when the direction was sampled (after the vertex's NEE)
     Spectrum beta;  // throughput after the direction's weight
@@ -181,6 +182,7 @@ constexpr int kMaxReturnVertices = 32;
 struct PendingRecord {
     int region = -1;
     Vec3 w{0.f};
+    int bin = -1;  // the guide's bin of w in region, or -1
     float target = 0.f;
     float weight = 1.f;
     bool active() const { return region >= 0; }
@@ -217,7 +219,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
-        ds.wi = guide_.field->sample(region, u, uStratum, &pGuide);
+        ds.wi = guide_.field->sample(region, u, uStratum, &pGuide, &ds.bin);
         if (!(pGuide > 0.f)) return DirectionSample();
         ds.f = bsdf.f(si.wo, ds.wi);
         pBsdf = bsdf.pdf(si.wo, ds.wi);
@@ -228,7 +230,7 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         ds.wi = bs.wi;
         ds.f = bs.f;
         pBsdf = bs.pdf;
-        pGuide = guide_.field->pdf(region, ds.wi);
+        pGuide = guide_.field->pdf(region, ds.wi, &ds.bin);
     }
     ds.pdf = mix * pGuide + (1.f - mix) * pBsdf;
     ds.pGuide = pGuide;
@@ -300,13 +302,14 @@ PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3
     const float mix = guideProbability(region, 1.f, &ds.scale);
     float pGuide = 0.f, pPhase = 0.f;
     if (uc < mix) {
-        ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide);
+        ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide,
+                                     &ds.bin);
         if (!(pGuide > 0.f)) return DirectionSample();
         pPhase = henyeyGreenstein(glm::dot(wo, ds.wi), g);
     } else {
         ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
         if (!(pPhase > 0.f)) return DirectionSample();
-        if (mix > 0.f) pGuide = guide_.field->pdf(region, ds.wi);
+        if (mix > 0.f) pGuide = guide_.field->pdf(region, ds.wi, &ds.bin);
     }
     ds.f = Spectrum(pPhase);
     ds.pdf = mix * pGuide + (1.f - mix) * pPhase;
@@ -385,9 +388,9 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     const bool returns = learn && guide_.pathTarget;
     ReturnVertex retVerts[kMaxReturnVertices];
     int numRet = 0;
-    auto pushReturn = [&](int region, const Vec3& w) {
+    auto pushReturn = [&](int region, const Vec3& w, int bin) {
         if (returns && region >= 0 && numRet < kMaxReturnVertices)
-            retVerts[numRet++] = ReturnVertex{region, w, L, beta};
+            retVerts[numRet++] = ReturnVertex{region, bin, w, L, beta};
     };
     auto pushSelection = [&](int region, const DirectionSample& ds) {
         if (!learnSelection || region < 0 || numSelVerts >= kMaxSelectionVertices) return;
@@ -412,7 +415,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     auto flush = [&](float addTarget) {
         if (!pending.active()) return;
         pending.target += pending.weight * addTarget;
-        field->record(slot, pending.region, pending.w, pending.target);
+        field->record(slot, pending.region, pending.w, pending.target, pending.bin);
         pending = PendingRecord();
     };
     for (int bounces = 0;; ++bounces) {
@@ -457,13 +460,14 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                     // Eq. 1 for the previous vertex, with the one-sample estimate of the
                     // light scattered here: Q(p, w') phase(w') / pdf(w').
                     if (pending.active() && region >= 0 && ds.pdf > 0.f) {
-                        const float est = field->radiance(region, ds.wi) * ds.f.x / ds.pdf;
+                        const float est = field->radiance(region, ds.wi, ds.bin) * ds.f.x / ds.pdf;
                         flush(std::isfinite(est) ? est : 0.f);
                     }
                     pending = PendingRecord();
                     if (region >= 0 && ds.pdf > 0.f) {
                         pending.region = region;
                         pending.w = ds.wi;
+                        pending.bin = ds.bin;
                     }
                 }
                 if (!(ds.pdf > 0.f)) break;
@@ -572,7 +576,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             // One-sample estimate of the Eq. 1 sum: Q(y, w') f(w') cos / pdf(w').
             float est = 0.f;
             if (ds.pdf > 0.f && !ds.transmission)
-                est = field->radiance(region, ds.wi) * luminance(ds.f) *
+                est = field->radiance(region, ds.wi, ds.bin) * luminance(ds.f) *
                       std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
             flush(emitted + (std::isfinite(est) ? est : 0.f));
         }
@@ -582,12 +586,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         beta *= weight;
         dirPdf = ds.pdf;
         specularBounce = ds.specular;
-        pushReturn(ds.transmission || lastDirection ? -1 : region, ds.wi);
+        pushReturn(ds.transmission || lastDirection ? -1 : region, ds.wi, ds.bin);
         if (learn) {
             if (bootstrap && region >= 0 && !ds.transmission) {
                 pending = PendingRecord();
                 pending.region = region;
                 pending.w = ds.wi;
+                pending.bin = ds.bin;
             } else if (pending.active() && region < 0 && !canGuide) {
                 pending.weight *= luminance(weight);  // through a delta vertex
             } else {
@@ -608,7 +613,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // knows it.
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
             sampleRegion >= 0 && !ds.transmission && field->confidence(sampleRegion) >= kRouletteConfidence) {
-            const float expected = luminance(beta) * field->radiance(sampleRegion, ds.wi);
+            const float expected = luminance(beta) * field->radiance(sampleRegion, ds.wi, ds.bin);
             const float low = guide_.rouletteWindow * pixelEstimate;
             if (expected < low) {
                 const float survive = std::max(expected / low, kMinSurvival);
@@ -630,7 +635,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const Spectrum d = L - v.L;
         Spectrum li(0.f);
         for (int c = 0; c < 3; ++c) li[c] = v.beta[c] > 0.f ? d[c] / v.beta[c] : 0.f;
-        field->record(slot, v.region, v.w, std::max(luminance(li), 0.f));
+        field->record(slot, v.region, v.w, std::max(luminance(li), 0.f), v.bin);
     }
     if (numSelVerts > 0) {
         const float lumL = luminance(L);

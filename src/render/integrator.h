@@ -121,6 +121,8 @@ private:
         // Guided strategies only: the guide's and the BSDF's (phase function's) pdfs of wi, and
         // the factor of the region's selection in the guide probability (confidence x share).
         float pGuide = 0.f, pOther = 0.f, scale = 0.f;
+        // The guide's bin of wi in the region it was drawn with (GuidingField::pdf), or -1.
+        int bin = -1;
     };
     // `share`: the BSDF's diffuse share; the probability of a guided sample is
     // guideProbability(region, share) (region < 0: BSDF only). The region's confidence is

@@ -507,6 +507,52 @@ TEST(HemiField, RunningMeanConvergesToTargets) {
     EXPECT_NEAR(g->pdf(0, glm::vec3(0, 0, 1)), 1.0 / (2.0 * kPi), 1e-6);
 }
 
+// The bin that pdf() and sample() report is the stratum record() and radiance() would find:
+// passing it gives the same Q, visits and radiance as passing the direction alone, and a bin
+// out of range is ignored (the direction decides).
+TEST(HemiField, BinsFromPdfAndSampleStandForTheDirection) {
+    const std::map<std::string, std::string> params = {{"points", "4"}, {"strata", "8x4"}};
+    auto f = makeHemi(planeScene(), params), g = makeHemi(planeScene(), params);
+    ASSERT_TRUE(f && g);
+    const int region = 0;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    f->beginPass(1);
+    g->beginPass(1);
+    for (int i = 0; i < 4000; ++i) {
+        glm::vec3 w;
+        int bin = -2;
+        if (i % 2 == 0) {
+            float p = 0.f;
+            w = f->sample(region, glm::vec2(uni(rng), uni(rng)), uni(rng), &p, &bin);
+            EXPECT_FLOAT_EQ(p, f->pdf(region, w));
+        } else {
+            w = glm::vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, uni(rng) - 0.5f);
+            f->pdf(region, w, &bin);
+        }
+        int again = -2;
+        g->pdf(region, w, &again);
+        ASSERT_EQ(bin, again);
+        const float t = float(i % 7);
+        f->record(0, region, w, t, bin);
+        g->record(0, region, w, t, i % 3 == 0 ? 1000 : -1);  // out of range: ignored
+    }
+    f->endPass();
+    g->endPass();
+    for (int j = 0; j < 32; ++j) {
+        EXPECT_EQ(f->q(region, j), g->q(region, j)) << j;
+        EXPECT_EQ(f->visits(region, j), g->visits(region, j)) << j;
+        const glm::vec3 c = strataCentre(*f, region, j);
+        int bin = -2;
+        f->pdf(region, c, &bin);
+        EXPECT_EQ(bin, j);
+        EXPECT_EQ(f->radiance(region, c, bin), f->radiance(region, c));
+    }
+    int bin = 0;
+    EXPECT_EQ(f->pdf(-1, glm::vec3(0, 0, 1), &bin), 0.f);
+    EXPECT_EQ(bin, -1);
+}
+
 TEST(HemiField, FixedAlphaFollowsGeometricSchedule) {
     const std::vector<std::pair<double, std::string>> alphas = {
         {1.0, "1"}, {0.5, "0.5"}, {0.1, "0.1"}, {1e-9, "1e-9"}};

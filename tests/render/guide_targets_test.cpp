@@ -26,35 +26,40 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 
 // One region everywhere, uniform over the upper hemisphere (z > 0), recording every target
-// and counting its lookups and samples.
+// and counting its lookups and samples. Its bins: 0 below 60 degrees from the normal, 1 above
+// (-1 outside the hemisphere).
 class RecordingField final : public guiding::GuidingField {
 public:
     struct Record {
         glm::vec3 w;
         float target;
+        int bin;  // as passed to record()
     };
+    static int binOf(const glm::vec3& w) { return w.z > 0.5f ? 0 : w.z > 0.f ? 1 : -1; }
     int lookup(const glm::vec3&, const glm::vec3& n) const override {
         ++lookups;
         return n.z > 0.f ? 0 : -1;
     }
-    glm::vec3 sample(int, glm::vec2 u, float, float* pdf) const override {
+    glm::vec3 sample(int, glm::vec2 u, float, float* pdf, int* bin) const override {
         ++samples;
         const float z = u.x, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * u.y;
-        *pdf = 1.f / (2.f * kPi);
-        return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
+        const glm::vec3 w(r * std::cos(phi), r * std::sin(phi), z);
+        *pdf = this->pdf(0, w, bin);
+        return w;
     }
-    float pdf(int, const glm::vec3& w) const override {
+    float pdf(int, const glm::vec3& w, int* bin) const override {
+        if (bin) *bin = binOf(w);
         return w.z > 0.f ? 1.f / (2.f * kPi) : 0.f;
     }
     float scatteredEstimate(int, const std::function<float(const glm::vec3&)>&) const override {
         return 0.f;
     }
-    float radiance(int, const glm::vec3&) const override { return 0.f; }
+    float radiance(int, const glm::vec3&, int) const override { return 0.f; }
     void beginPass(int) override {}
-    void record(int, int region, const glm::vec3& w, float target) override {
+    void record(int, int region, const glm::vec3& w, float target, int bin) override {
         std::lock_guard<std::mutex> lock(mutex_);
         EXPECT_EQ(region, 0);
-        records.push_back(Record{w, target});
+        records.push_back(Record{w, target, bin});
     }
     void endPass() override {}
     size_t bytes() const override { return 0; }
@@ -131,6 +136,9 @@ TEST(GuideTargets, PathTargetIsTheMisWeightedReturnOfTheDirection) {
     double meanTarget = 0.0;
     for (const auto& r : records) {
         ASSERT_GT(r.w.z, 0.f);
+        // Guided or drawn from the BSDF, the direction's bin found by sample() or pdf() comes
+        // back with its record (the field need not find it again).
+        EXPECT_EQ(r.bin, RecordingField::binOf(r.w)) << r.w.z;
         // The direction's mixture pdf: half the guide's uniform hemisphere, half Lambertian.
         const float dirPdf = 0.5f / (2.f * kPi) + 0.5f * r.w.z / kPi;
         const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
@@ -150,7 +158,10 @@ TEST(GuideTargets, EquationOneTargetIsTheFullEmission) {
     ASSERT_TRUE(scene);
     const auto records = train(*scene, false);
     ASSERT_GT(records.size(), 1900u);
-    for (const auto& r : records) EXPECT_NEAR(r.target, luminance(Spectrum(1.f)), 1e-5f);
+    for (const auto& r : records) {
+        EXPECT_NEAR(r.target, luminance(Spectrum(1.f)), 1e-5f);
+        EXPECT_EQ(r.bin, RecordingField::binOf(r.w)) << r.w.z;
+    }
 }
 
 // The path's last direction (here the only one, maxdepth 1) brings back only emission that
