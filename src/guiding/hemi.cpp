@@ -216,16 +216,14 @@ void HemiField::recordSelection(int slot, int region, const SelectionSample& s) 
 }
 
 float HemiField::radiance(int region, const glm::vec3& w, int bin) const {
-    const int j = validRegion(region) && bin >= 0 && bin < strata_ ? bin : stratumOf(region, w);
+    const int j = stratumOf(region, w, bin);
     return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
 void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
-    table_.record(slot, region, target, [&] {
-        return validRegion(region) && bin >= 0 && bin < strata_ ? bin : stratumOf(region, w);
-    });
+    table_.record(slot, region, target, [&] { return stratumOf(region, w, bin); });
 }
 
 void HemiField::updateRegion(int region, const double* q) {

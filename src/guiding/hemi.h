@@ -134,6 +134,11 @@ public:
     }
     // Stratum of world direction w in a region's hemisphere, -1 outside.
     int stratumOf(int region, const glm::vec3& w) const;
+    // The same, given the bin that pdf()/sample() reported for it (-1 or out of range: found
+    // from w).
+    int stratumOf(int region, const glm::vec3& w, int bin) const {
+        return validRegion(region) && bin >= 0 && bin < strata_ ? bin : stratumOf(region, w);
+    }
     // Learned Q and visit count of one stratum.
     double q(int region, int stratum) const { return table_.q(size_t(region))[stratum]; }
     uint64_t visits(int region, int stratum) const {

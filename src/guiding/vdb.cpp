@@ -447,8 +447,7 @@ float VdbField::irradianceEstimate(int region, const glm::vec3& n) const {
 
 float VdbField::radiance(int region, const glm::vec3& w, int bin) const {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->radiance(cell, w);
-    const int j =
-        validRegion(region) && bin >= 0 && bin < table_.strata() ? bin : stratumOf(region, w);
+    const int j = stratumOf(region, w, bin);
     return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
@@ -471,10 +470,7 @@ void VdbField::beginPass(int numSlots) {
 
 void VdbField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->record(slot, cell, w, target);
-    table_.record(slot, region, target, [&] {
-        return validRegion(region) && bin >= 0 && bin < table_.strata() ? bin
-                                                                         : stratumOf(region, w);
-    });
+    table_.record(slot, region, target, [&] { return stratumOf(region, w, bin); });
 }
 
 void VdbField::endPass() {

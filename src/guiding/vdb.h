@@ -107,6 +107,12 @@ public:
     // Unit world direction of stratum j's centre in a region.
     glm::vec3 strataCentre(int region, int j) const;
     int stratumOf(int region, const glm::vec3& w) const;
+    // The same, given the bin that pdf()/sample() reported for it (-1 or out of range: found
+    // from w).
+    int stratumOf(int region, const glm::vec3& w, int bin) const {
+        return validRegion(region) && bin >= 0 && bin < table_.strata() ? bin
+                                                                         : stratumOf(region, w);
+    }
     double q(int region, int stratum) const { return table_.q(size_t(region))[stratum]; }
     uint64_t visits(int region, int stratum) const {
         return table_.visits(size_t(region))[stratum];
