@@ -612,7 +612,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // From the second vertex on: roulette on the expected contribution where the guide
         // knows it.
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
-            sampleRegion >= 0 && !ds.transmission && field->confidence(sampleRegion) >= kRouletteConfidence) {
+            sampleRegion >= 0 && !ds.transmission &&
+            field->confidence(sampleRegion) >= kRouletteConfidence) {
             const float expected = luminance(beta) * field->radiance(sampleRegion, ds.wi, ds.bin);
             const float low = guide_.rouletteWindow * pixelEstimate;
             if (expected < low) {
