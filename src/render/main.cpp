@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     app.add_option("--guide-param", guideParams,
                    "guiding parameter key=value (repeatable): mix (0..1 or learn), alpha, "
                    "strata (WxH), points, normal-angle, init, epsilon, cosine, smooth, max-mb, "
-                   "target (path, sample or sum), rr (adjoint or pbrt), samples, auto (N "
+                   "target (path, sample or sum), rr (adjoint or pbrt), rr-window, samples, auto (N "
                    "spp: a guided-or-plain trial; default off); hemi: knn, warmup, lookup "
                    "(cell or exact); vdb: "
                    "voxel, voxel-size, dirs, normals, warmup, volume, volume-voxel "
