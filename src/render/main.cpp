@@ -63,7 +63,7 @@ std::string defaultOutput(const Scene& scene) {
 
 int main(int argc, char** argv) {
     CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
-    std::string scenePath, outFile, statsFile, guide = "none", curveFile, refFile;
+    std::string scenePath, outFile, statsFile, guide = "hemi", curveFile, refFile;
     std::string guideSave, guideLoad;
     bool parseOnly = false, quiet = false;
     int spp = 0, nThreads = 0;
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     app.add_option("--seed", seed, "random seed");
     app.add_flag("--quiet,-q", quiet, "no progress or summary output");
     std::vector<std::string> guideParams;
-    app.add_option("--guide", guide, "guiding backend: none, hemi or vdb")
+    app.add_option("--guide", guide, "guiding backend: none, hemi (the default) or vdb")
         ->check(CLI::IsMember({"none", "hemi", "vdb"}));
     app.add_option("--guide-param", guideParams,
                    "guiding parameter key=value (repeatable): mix (0..1 or learn), alpha, "
