@@ -2,7 +2,8 @@
 # Scripted benchmarks against pbrt-v3's figures in ../shared/references/manifest.tsv.
 #   bench/scene_bench.sh parse   parse+build of conference-room (8x8 image, 1 spp, 1 thread),
 #                                the issue's comparison with pbrt-v3's ~1.5 s
-#   bench/scene_bench.sh render  every manifest scene at 64 spp with 2 threads: wall time
+#   bench/scene_bench.sh render  every manifest scene at 64 spp with 2 threads, --guide none:
+#                                wall time
 #                                against pbrt-v3's 64-spp wall time (both include parsing)
 # Prints a markdown table; runs each measurement REPEAT times (default 3) and keeps the median.
 set -euo pipefail
@@ -27,7 +28,7 @@ parse)
         -e 's/^Sampler .*/Sampler "sobol" "integer pixelsamples" [1]/' \
         -e "s|^Include \"conference_room-world.pbrt\"|Include \"$shared/scenes/conference-room/conference_room-world.pbrt\"|" \
         "$shared/scenes/conference-room/conference_room.small.pbrt" > "$scene"
-    t=$(for i in $(seq "$repeat"); do wall "$bin" "$scene" --nthreads 1 -o "$tmp/o.exr" --quiet; done | median)
+    t=$(for i in $(seq "$repeat"); do wall "$bin" "$scene" --guide none --nthreads 1 -o "$tmp/o.exr" --quiet; done | median)
     p=$("$bin" --parse-only "$scene" --nthreads 1 | grep -oP 'parse: \K[0-9.]+ s, build: [0-9.]+')
     printf "| conference-room 8x8, 1 spp, 1 thread | %.3f s | 1.5 s | %.1fx | %s s |\n" "$t" "$(echo "1.5 / $t" | bc -l)" "$p"
     ;;
@@ -36,7 +37,7 @@ render)
     echo "|---|---:|---:|---:|"
     tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media; do
         [ "$media" = "1" ] && [ "${MEDIA:-1}" = "0" ] && continue  # MEDIA=0: surface scenes only
-        t=$(for i in $(seq "$repeat"); do wall "$bin" "$shared/scenes/$scene" --spp 64 --nthreads 2 -o "$tmp/o.exr" --quiet; done | median)
+        t=$(for i in $(seq "$repeat"); do wall "$bin" "$shared/scenes/$scene" --guide none --spp 64 --nthreads 2 -o "$tmp/o.exr" --quiet; done | median)
         printf '| %s | %.2f | %.2f | %.2fx |\n' "$id" "$t" "$s64" "$(echo "$s64 / $t" | bc -l)"
     done
     ;;
