@@ -3,8 +3,8 @@
 #   bench/scene_bench.sh parse   parse+build of conference-room (8x8 image, 1 spp, 1 thread),
 #                                the issue's comparison with pbrt-v3's ~1.5 s
 #   bench/scene_bench.sh render  every manifest scene at 64 spp with 2 threads, --guide none:
-#                                wall time
-#                                against pbrt-v3's 64-spp wall time (both include parsing)
+#                                wall time against pbrt-v3's 64-spp wall time (both include
+#                                parsing)
 # Prints a markdown table; runs each measurement REPEAT times (default 3) and keeps the median.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
