@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "parser/spd.h"
@@ -227,9 +229,13 @@ TEST(Spectrum, MetalSpdFiles) {
 
 class SpdFileTest : public ::testing::Test {
 protected:
+    // Names unique per test and process: ctest runs this fixture's tests in parallel.
     std::string write(const std::string& text) {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         std::string path = (std::filesystem::temp_directory_path() /
-                            ("rlpbrt_spd_test_" + std::to_string(counter_++) + ".spd"))
+                            (std::string("rlpbrt_spd_") + info->name() + "_" +
+                             std::to_string(getpid()) + "_" + std::to_string(counter_++) +
+                             ".spd"))
                                .string();
         std::ofstream(path) << text;
         files_.push_back(path);
