@@ -167,7 +167,8 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, warmup, lookup, smooth, max-mb, mix, target, samples, auto, rr)";
+                     "cosine, warmup, lookup, smooth, max-mb, mix, target, samples, auto, rr, "
+                     "rr-window)";
             return false;
         }
     }
@@ -218,7 +219,7 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             *error = "guiding backend 'vdb': unknown parameter '" + key +
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
                      "normal-angle, init, epsilon, cosine, warmup, smooth, volume, "
-                     "volume-voxel, max-mb, mix, target, samples, auto, rr)";
+                     "volume-voxel, max-mb, mix, target, samples, auto, rr, rr-window)";
             return false;
         }
     }

@@ -43,10 +43,10 @@ public:
     // of level 1 that holds stratum j, levels[1][i] = the parent of that node, ..., the last
     // level has a single node, the root). A node's estimate is (S + prior * parent's estimate)
     // / (N + prior), with N the visits under it and S the sum of their targets (visits x Q
-    // for a stratum); the root's is S / N (reset()'s `init` while N = 0). A stratum with few visits thus
-    // borrows its coarser neighbourhood's mean, one with many keeps its own Q, and a stratum
-    // without visits is not taken for dark (which removes the bias of guided passes that
-    // continue each pixel's sequence, docs/STABILITY.md). prior 0 or no levels: the
+    // for a stratum); the root's is S / N (reset()'s `init` while N = 0). A stratum with few
+    // visits thus borrows its coarser neighbourhood's mean, one with many keeps its own Q, and a
+    // stratum without visits is not taken for dark (which removes the bias of guided passes
+    // that continue each pixel's sequence, docs/STABILITY.md). prior 0 or no levels: the
     // estimates are Q. Call before reset()/grow()/assign() build the policy.
     void setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior);
     // The (unrounded) estimates of one region, strata doubles.

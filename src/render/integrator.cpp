@@ -39,6 +39,15 @@ PathIntegrator::PathIntegrator(const Scene& scene, const GuideSettings& guide)
     if (guide_.mix == 0.f && !guide_.learn) guide_.field = nullptr;
 }
 
+namespace {
+// A whole-string number (strtof syntax); false if the text is anything else.
+bool parseFloat(const std::string& text, float* out) {
+    char* end = nullptr;
+    *out = std::strtof(text.c_str(), &end);
+    return end != text.c_str() && *end == '\0';
+}
+}  // namespace
+
 bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
                   std::unique_ptr<guiding::GuidingField>* field, GuideSettings* settings,
                   std::string* error) {
@@ -48,9 +57,8 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     if (it != config.params.end() && it->second == "learn") {
         settings->learnMix = true;
     } else if (it != config.params.end()) {
-        char* end = nullptr;
-        float mix = std::strtof(it->second.c_str(), &end);
-        if (end == it->second.c_str() || *end != '\0' || !(mix >= 0.f && mix <= 1.f)) {
+        float mix = 0.f;
+        if (!parseFloat(it->second, &mix) || !(mix >= 0.f && mix <= 1.f)) {
             *error = "mix must be a number in [0, 1] or \"learn\", got \"" + it->second + "\"";
             return false;
         }
@@ -85,9 +93,8 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     }
     auto window = config.params.find("rr-window");
     if (window != config.params.end()) {
-        char* end = nullptr;
-        const float w = std::strtof(window->second.c_str(), &end);
-        if (end == window->second.c_str() || *end != '\0' || !(w > 0.f && w <= 1.f)) {
+        float w = 0.f;
+        if (!parseFloat(window->second, &w) || !(w > 0.f && w <= 1.f)) {
             *error = "rr-window must be a number in (0, 1], got \"" + window->second + "\"";
             return false;
         }
