@@ -19,6 +19,7 @@ void BSDF::init(const Vec3& ng, const Vec3& ns, const Vec3& tangent, float eta) 
 
 bool BSDF::add(const BxDF& bxdf) {
     if (n_ >= MaxBxDFs) return false;
+    flags_[n_] = bxdf.flags();
     bxdfs_[n_++] = bxdf;
     return true;
 }
@@ -26,20 +27,20 @@ bool BSDF::add(const BxDF& bxdf) {
 int BSDF::numComponents(BxDFFlags flags) const {
     int count = 0;
     for (int i = 0; i < n_; ++i)
-        if (bxdfs_[i].matchesFlags(flags)) ++count;
+        if (matchesFlags(flags_[i], flags)) ++count;
     return count;
 }
 
 bool BSDF::isDelta() const {
     if (n_ == 0) return false;
     for (int i = 0; i < n_; ++i)
-        if (!hasAny(bxdfs_[i].flags(), BxDFFlags::Specular)) return false;
+        if (!hasAny(flags_[i], BxDFFlags::Specular)) return false;
     return true;
 }
 
 BxDFFlags BSDF::flags() const {
     BxDFFlags all = BxDFFlags::None;
-    for (int i = 0; i < n_; ++i) all = all | bxdfs_[i].flags();
+    for (int i = 0; i < n_; ++i) all = all | flags_[i];
     return all;
 }
 
@@ -52,8 +53,8 @@ Spectrum BSDF::f(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags) cons
     Spectrum sum(0.f);
     for (int i = 0; i < n_; ++i) {
         const BxDF& b = bxdfs_[i];
-        if (!b.matchesFlags(flags)) continue;
-        BxDFFlags bf = b.flags();
+        const BxDFFlags bf = flags_[i];
+        if (!matchesFlags(bf, flags)) continue;
         if ((reflect && hasAny(bf, BxDFFlags::Reflection)) ||
             (!reflect && hasAny(bf, BxDFFlags::Transmission)))
             sum += b.f(wo, wi);
@@ -69,7 +70,7 @@ BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags)
     const BxDF* chosen = nullptr;
     int chosenIndex = -1;
     for (int i = 0, count = comp; i < n_; ++i) {
-        if (bxdfs_[i].matchesFlags(flags) && count-- == 0) {
+        if (matchesFlags(flags_[i], flags) && count-- == 0) {
             chosen = &bxdfs_[i];
             chosenIndex = i;
             break;
@@ -87,11 +88,11 @@ BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags)
     s.flags = ls.flags;
     s.pdf = ls.pdf;
     s.f = ls.f;
-    bool specular = hasAny(chosen->flags(), BxDFFlags::Specular);
+    bool specular = hasAny(flags_[chosenIndex], BxDFFlags::Specular);
     // Non-specular: the sample could have come from any matching lobe (one-sample MIS).
     if (!specular && matching > 1) {
         for (int i = 0; i < n_; ++i)
-            if (i != chosenIndex && bxdfs_[i].matchesFlags(flags))
+            if (i != chosenIndex && matchesFlags(flags_[i], flags))
                 s.pdf += bxdfs_[i].pdf(wo, ls.wi);
     }
     if (matching > 1) s.pdf /= matching;
@@ -100,8 +101,8 @@ BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags)
         Spectrum sum(0.f);
         for (int i = 0; i < n_; ++i) {
             const BxDF& b = bxdfs_[i];
-            if (!b.matchesFlags(flags)) continue;
-            BxDFFlags bf = b.flags();
+            const BxDFFlags bf = flags_[i];
+            if (!matchesFlags(bf, flags)) continue;
             if ((reflect && hasAny(bf, BxDFFlags::Reflection)) ||
                 (!reflect && hasAny(bf, BxDFFlags::Transmission)))
                 sum += b.f(wo, ls.wi);
@@ -118,7 +119,7 @@ float BSDF::pdf(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags) const
     float sum = 0.f;
     int matching = 0;
     for (int i = 0; i < n_; ++i) {
-        if (!bxdfs_[i].matchesFlags(flags)) continue;
+        if (!matchesFlags(flags_[i], flags)) continue;
         ++matching;
         sum += bxdfs_[i].pdf(wo, wi);
     }

@@ -77,6 +77,7 @@ class BSDF {
     Vec3 ng_{0.f, 0.f, 1.f};
     float eta_ = 1.f;
     int n_ = 0;
+    BxDFFlags flags_[MaxBxDFs];  // each lobe's flags, taken at add() (queried per vertex)
     BxDF bxdfs_[MaxBxDFs];
 };
 
