@@ -76,6 +76,23 @@ bool badValue(const char* backend, const std::string& key, const std::string& va
     return false;
 }
 
+// A strata value, "WxH" or "N" (N x N), with integers in 1..64; false if it is anything else.
+bool parseStrata(const std::string& value, int* cols, int* rows) {
+    const size_t x = value.find_first_of("xX");
+    uint64_t w = 0, h = 0;
+    if (x == std::string::npos) {
+        if (!parseUnsigned(value, 64, &w)) return false;
+        h = w;
+    } else if (!parseUnsigned(value.substr(0, x), 64, &w) ||
+               !parseUnsigned(value.substr(x + 1), 64, &h)) {
+        return false;
+    }
+    if (w < 1 || h < 1) return false;
+    *cols = int(w);
+    *rows = int(h);
+    return true;
+}
+
 // The parameters hemi and vdb share (same names, ranges and members): 1 if `key` is one of
 // them and its value is valid, 0 if it is not a shared key, -1 (and *error) on a bad value.
 template <class Params>
@@ -97,19 +114,8 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
             return bad("'visits' or a number in (0, 1]");
         }
     } else if (key == "strata") {
-        const char* expected = "WxH or N with integers in 1..64";
-        size_t x = value.find_first_of("xX");
-        uint64_t w = 0, h = 0;
-        if (x == std::string::npos) {
-            if (!parseUnsigned(value, 64, &w)) return bad(expected);
-            h = w;
-        } else if (!parseUnsigned(value.substr(0, x), 64, &w) ||
-                   !parseUnsigned(value.substr(x + 1), 64, &h)) {
-            return bad(expected);
-        }
-        if (w < 1 || h < 1) return bad(expected);
-        p->cols = int(w);
-        p->rows = int(h);
+        if (!parseStrata(value, &p->cols, &p->rows))
+            return bad("WxH or N with integers in 1..64");
     } else if (key == "points") {
         if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
             return bad("an integer in 1..67108864");
@@ -209,6 +215,13 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
         } else if (key == "volume") {
             if (value != "0" && value != "1") return badValue("vdb", key, value, "0 or 1", error);
             vp->volume = value == "1";
+        } else if (key == "volume-strata") {
+            if (!parseStrata(value, &vp->volumeCols, &vp->volumeRows))
+                return badValue("vdb", key, value, "WxH or N with integers in 1..64", error);
+        } else if (key == "volume-warmup") {
+            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
+                return badValue("vdb", key, value, "a number in [0, 1e9]", error);
+            vp->volumeWarmup = d;
         } else if (key == "volume-voxel") {
             if (!parseUnsigned(value, 1024, &u) || u < 1)
                 return badValue("vdb", key, value,
@@ -219,7 +232,8 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             *error = "guiding backend 'vdb': unknown parameter '" + key +
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
                      "normal-angle, init, epsilon, cosine, warmup, smooth, volume, "
-                     "volume-voxel, max-mb, mix, target, samples, auto, rr, rr-window)";
+                     "volume-voxel, volume-strata, volume-warmup, max-mb, mix, target, "
+                     "samples, auto, rr, rr-window)";
             return false;
         }
     }

@@ -164,7 +164,7 @@ public:
 // (parameters are ignored). Unknown backend or parameter, or a bad value => nullptr and a
 // message in *error. Backend "hemi" parameters:
 //   alpha        "visits" (default: 1/(1+visits), batch running mean) or a number in (0,1]
-//   strata       "WxH" (default 16x16 for hemi, 8x8 for vdb): W columns in phi, H rows in
+//   strata       "WxH" (default 16x16): W columns in phi, H rows in
 //                cos(theta), each 1..64;
 //                "N" means NxN
 //   points       surface samples, 1..2^26 (default 2048); each gives two hemispheres (n, -n)
@@ -176,8 +176,8 @@ public:
 //                cell (cells of the points' mean spacing), memoised per cell; "exact": the
 //                knn points nearest to the vertex (kd-tree query per vertex)
 //   warmup       records per stratum until a region's policy gets the full mixture weight:
-//                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 8 for
-//                hemi, 16 for vdb; 0 = always full weight, the paper's behaviour)
+//                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 8;
+//                0 = always full weight, the paper's behaviour)
 //   smooth       prior strength, in visits, of the hierarchical smoothing of the strata
 //                estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
@@ -208,6 +208,9 @@ public:
 //                whose voxels are activated where paths scatter (guiding/vdb_volume.h)
 //   volume-voxel N: N voxels along the longest axis of the media bounds, 1..1024
 //                (default 32); max-mb caps the number of activated voxels
+//   volume-strata the medium tables' strata per hemisphere, as strata (default 8x8, whatever
+//                the surface tables use)
+//   volume-warmup the medium tables' warmup, as warmup (default 16)
 std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
                                                  const SceneInfo& scene, std::string* error);
 

@@ -82,7 +82,7 @@ double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
 
 double vdbMediumCellBytes(const VdbParams& params) {
     // Per stratum Q (double), float Q, visits and the CDF entry; per cell ~64 bytes more.
-    return 2.0 * params.cols * params.rows *
+    return 2.0 * params.volumeCols * params.volumeRows *
                (sizeof(double) + 2 * sizeof(float) + sizeof(uint64_t)) +
            64.0 + SelectionLearner::kBytesPerRegion;
 }
@@ -193,12 +193,12 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
     if (params_.volume && scene.hasMedia()) {
         VolumeParams vp;
         vp.voxelCount = params_.volumeVoxels;
-        vp.cols = params_.cols;
-        vp.rows = params_.rows;
+        vp.cols = params_.volumeCols;
+        vp.rows = params_.volumeRows;
         vp.init = params_.init;
         vp.smooth = params_.smooth;
         vp.epsilon = params_.epsilon;
-        vp.warmup = params_.warmup;
+        vp.warmup = params_.volumeWarmup;
         vp.alphaVisits = params_.alphaVisits;
         vp.fixedAlpha = params_.fixedAlpha;
         vp.maxVoxels = params_.volumeMaxVoxels;
@@ -571,6 +571,8 @@ bool VdbField::save(const std::string& path, std::string* error) const {
             counters.u64(vs.records), counters.u64(vs.rejectedTargets),
                 counters.u64(vs.rejectedRecords);
             copy->insertMeta("rlpbrt:volume_voxel_size", openvdb::DoubleMetadata(volume_->voxelSize()));
+            copy->insertMeta("rlpbrt:volume_strata", openvdb::Vec2IMetadata(openvdb::Vec2i(
+                                                         params_.volumeCols, params_.volumeRows)));
             copy->insertMeta("rlpbrt:volume_cells", openvdb::StringMetadata(coords.data));
             copy->insertMeta("rlpbrt:volume_q",
                              openvdb::StringMetadata(fieldio::packDoubles(volume_->table().qTable())));
@@ -725,6 +727,15 @@ bool VdbField::load(const std::string& path, std::string* error) {
             if (vh != volume_->voxelSize())
                 return fail("medium voxel size " + std::to_string(vh) + ", this field has " +
                             std::to_string(volume_->voxelSize()) + " (use the same volume-voxel)");
+            // (Files without the entry come from versions whose medium tables had the surface
+            // tables' strata.)
+            const auto vs = grid->getMetadata<openvdb::Vec2IMetadata>("rlpbrt:volume_strata");
+            const openvdb::Vec2i fileVs = vs ? vs->value() : st;
+            if (fileVs[0] != params_.volumeCols || fileVs[1] != params_.volumeRows)
+                return fail("medium strata " + std::to_string(fileVs[0]) + "x" +
+                            std::to_string(fileVs[1]) + ", this field has " +
+                            std::to_string(params_.volumeCols) + "x" +
+                            std::to_string(params_.volumeRows) + " (use the same volume-strata)");
             const std::string cb = grid->metaValue<std::string>("rlpbrt:volume_cells");
             if (cb.size() % 12 != 0) return fail("corrupt medium cell table");
             const size_t cells = cb.size() / 12;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -65,6 +66,47 @@ TEST(VdbVolume, OnlyScenesWithMediaGetTablesAndParametersAreChecked) {
     GuideConfig cfg{"vdb", {{"volume", "yes"}}};
     std::string error;
     EXPECT_FALSE(createGuidingField(cfg, foggyPlane(), &error));
+}
+
+// The medium tables keep their own strata and warmup (8x8 and 16 by default) whatever the
+// surface tables use (16x16 and 8).
+TEST(VdbVolume, MediumTablesHaveTheirOwnStrataAndWarmup) {
+    auto def = makeVdb(foggyPlane(), {{"volume-voxel", "4"}});
+    ASSERT_TRUE(def && def->volume());
+    EXPECT_EQ(def->strataPerRegion(), 256);
+    EXPECT_EQ(def->params().warmup, 8.0);
+    EXPECT_EQ(def->volume()->strata(), 2 * 8 * 8);
+    EXPECT_EQ(def->volume()->params().warmup, 16.0);
+    auto f = makeVdb(foggyPlane(), {{"volume-voxel", "4"},
+                                    {"strata", "8x4"},
+                                    {"volume-strata", "4x2"},
+                                    {"volume-warmup", "3"}});
+    ASSERT_TRUE(f && f->volume());
+    EXPECT_EQ(f->strataPerRegion(), 32);
+    EXPECT_EQ(f->volume()->strata(), 2 * 4 * 2);
+    EXPECT_EQ(f->volume()->params().warmup, 3.0);
+    // A medium cell's pdf integrates to one over the sphere with its own strata.
+    activate(*f, {glm::vec3(0.3f, 0.6f, 0.2f)});
+    const int cell = f->lookupMedium(glm::vec3(0.3f, 0.6f, 0.2f));
+    ASSERT_GE(cell, 0);
+    double sum = 0.0;
+    const int n = 400;
+    for (int i = 0; i < n; ++i)
+        for (int k = 0; k < n; ++k) {
+            const float z = 1.f - 2.f * (float(i) + 0.5f) / float(n);
+            const float phi = 2.f * 3.14159265f * (float(k) + 0.5f) / float(n);
+            const float r = std::sqrt(std::max(0.f, 1.f - z * z));
+            sum += double(f->pdf(cell, glm::vec3(r * std::cos(phi), r * std::sin(phi), z)));
+        }
+    EXPECT_NEAR(sum * 4.0 * 3.14159265358979 / (double(n) * n), 1.0, 1e-3);
+    for (const auto& [key, bad] : std::vector<std::pair<std::string, std::string>>{
+             {"volume-strata", "0"}, {"volume-strata", "65"}, {"volume-strata", "4x"},
+             {"volume-warmup", "-1"}, {"volume-warmup", "x"}}) {
+        GuideConfig cfg{"vdb", {{key, bad}}};
+        std::string error;
+        EXPECT_FALSE(createGuidingField(cfg, foggyPlane(), &error)) << key << "=" << bad;
+        EXPECT_NE(error.find(key), std::string::npos) << error;
+    }
 }
 
 TEST(VdbVolume, VoxelsAreActivatedWhereRequestedInSlotOrder) {
@@ -215,6 +257,11 @@ TEST(VdbVolume, SaveLoadRoundTripKeepsMediumTables) {
     auto d = makeVdb(foggyPlane(), {{"volume", "0"}});
     EXPECT_FALSE(d->load(path, &error));
     EXPECT_NE(error.find("medium tables"), std::string::npos) << error;
+    // So does one whose medium tables have other strata.
+    auto e = makeVdb(foggyPlane(), {{"volume-voxel", "4"}, {"volume-strata", "4"}});
+    EXPECT_FALSE(e->load(path, &error));
+    EXPECT_NE(error.find("volume-strata"), std::string::npos) << error;
+    EXPECT_EQ(e->volume()->cells(), 0);
     std::remove(path.c_str());
 }
 
