@@ -372,6 +372,16 @@ float PathIntegrator::scatteredTarget(const SurfaceInteraction& si, const BSDF& 
     });
 }
 
+bool PathIntegrator::pbrtRoulette(Spectrum* beta, float etaScale, int bounces,
+                                  Sampler& sampler) const {
+    const float m = maxComponent(*beta * etaScale);
+    if (!(m < rrThreshold_) || bounces <= 3) return true;
+    const float q = std::max(0.05f, 1.f - m);
+    if (sampler.get1D() < q) return false;
+    *beta /= 1.f - q;
+    return true;
+}
+
 Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& stats,
                             int slot, float pixelEstimate) const {
     Spectrum L(0.f), beta(1.f);
@@ -485,12 +495,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 specularBounce = false;
                 prev = LightSampleContext{p, Vec3(0.f)};
                 ray = Ray(p, wi);
-                Spectrum rrBeta = beta * etaScale;
-                if (maxComponent(rrBeta) < rrThreshold_ && bounces > 3) {
-                    float q = std::max(0.05f, 1.f - maxComponent(rrBeta));
-                    if (sampler.get1D() < q) break;
-                    beta /= 1.f - q;
-                }
+                if (!pbrtRoulette(&beta, etaScale, bounces, sampler)) break;
                 continue;
             }
         }
@@ -630,13 +635,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             }
             continue;
         }
-        // Russian roulette (pbrt-v3: after bounce 3, on beta scaled by the refraction eta).
-        Spectrum rrBeta = beta * etaScale;
-        if (maxComponent(rrBeta) < rrThreshold_ && bounces > 3) {
-            float q = std::max(0.05f, 1.f - maxComponent(rrBeta));
-            if (sampler.get1D() < q) break;
-            beta /= 1.f - q;
-        }
+        if (!pbrtRoulette(&beta, etaScale, bounces, sampler)) break;
     }
     for (int i = 0; i < numRet; ++i) {
         const ReturnVertex& v = retVerts[i];

@@ -171,6 +171,10 @@ private:
     // medium boundaries (interface-only surfaces), zero at any other surface.
     Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
                            PathStats& stats) const;
+    // pbrt-v3's Russian roulette after bounce 3 on the throughput scaled by the refraction
+    // eta: false if the path ends here, else true with *beta divided by the survival
+    // probability (draws a sampler dimension only when it plays).
+    bool pbrtRoulette(Spectrum* beta, float etaScale, int bounces, Sampler& sampler) const;
     // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance).
     float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
                           const Vec3& woY) const;
