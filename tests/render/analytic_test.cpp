@@ -398,6 +398,22 @@ TEST(AdjointRoulette, EnclosureStaysExact) { expectAdjointRouletteExact(12, "0.1
 // remainder is below its pixel's estimate is at risk).
 TEST(AdjointRoulette, ShallowPathsStayExact) { expectAdjointRouletteExact(3, "1"); }
 
+// The adjoint roulette waits for pixel estimates of at least 8 samples per pixel (the
+// passes of 1, 1, 1, 1, 2, 3 spp before; render.cpp): a 4-spp render equals pbrt-v3's
+// roulette to the bit, a 16-spp one does not.
+TEST(AdjointRoulette, WaitsForEightSamplesPerPixel) {
+    const std::string scene = enclosure(0.5, 1.0, 3);
+    for (const auto& [spp, same] : {std::pair<int, bool>{4, true}, {16, false}}) {
+        Rendered adjoint = renderText(
+            scene, "hemi", {{"rr", "adjoint"}, {"rr-window", "1"}, {"warmup", "0"}}, spp);
+        Rendered plain = renderText(scene, "hemi", {{"rr", "pbrt"}, {"warmup", "0"}}, spp);
+        ASSERT_TRUE(adjoint.ok && plain.ok);
+        ASSERT_EQ(adjoint.image.pixels.size(), plain.image.pixels.size());
+        const bool equal = adjoint.image.pixels == plain.image.pixels;
+        EXPECT_EQ(equal, same) << spp << " spp";
+    }
+}
+
 // The vdb backend's medium tables at their extremes: pure policy without warmup, no uniform
 // floor, one voxel for the whole medium, the finest grid. The thick forward-scattering fog
 // runs only where the phase function stays in the mixture (mix < 1 bounds each vertex's
