@@ -44,22 +44,21 @@ BxDFFlags BSDF::flags() const {
     return all;
 }
 
+Spectrum BSDF::sumF(const Vec3& wo, const Vec3& wi, bool reflect, BxDFFlags flags) const {
+    const BxDFFlags side = reflect ? BxDFFlags::Reflection : BxDFFlags::Transmission;
+    Spectrum sum(0.f);
+    for (int i = 0; i < n_; ++i)
+        if (matchesFlags(flags_[i], flags) && hasAny(flags_[i], side))
+            sum += bxdfs_[i].f(wo, wi);
+    return sum;
+}
+
 Spectrum BSDF::f(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags) const {
     Vec3 wi = worldToLocal(wiWorld), wo = worldToLocal(woWorld);
     if (wo.z == 0.f) return Spectrum(0.f);
     // The geometric normal decides between reflection and transmission, avoiding light leaks
     // when shading normals disagree with the true surface.
-    bool reflect = glm::dot(wiWorld, ng_) * glm::dot(woWorld, ng_) > 0.f;
-    Spectrum sum(0.f);
-    for (int i = 0; i < n_; ++i) {
-        const BxDF& b = bxdfs_[i];
-        const BxDFFlags bf = flags_[i];
-        if (!matchesFlags(bf, flags)) continue;
-        if ((reflect && hasAny(bf, BxDFFlags::Reflection)) ||
-            (!reflect && hasAny(bf, BxDFFlags::Transmission)))
-            sum += b.f(wo, wi);
-    }
-    return sum;
+    return sumF(wo, wi, glm::dot(wiWorld, ng_) * glm::dot(woWorld, ng_) > 0.f, flags);
 }
 
 BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags) const {
@@ -96,19 +95,8 @@ BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags)
                 s.pdf += bxdfs_[i].pdf(wo, ls.wi);
     }
     if (matching > 1) s.pdf /= matching;
-    if (!specular) {
-        bool reflect = glm::dot(s.wi, ng_) * glm::dot(woWorld, ng_) > 0.f;
-        Spectrum sum(0.f);
-        for (int i = 0; i < n_; ++i) {
-            const BxDF& b = bxdfs_[i];
-            const BxDFFlags bf = flags_[i];
-            if (!matchesFlags(bf, flags)) continue;
-            if ((reflect && hasAny(bf, BxDFFlags::Reflection)) ||
-                (!reflect && hasAny(bf, BxDFFlags::Transmission)))
-                sum += b.f(wo, ls.wi);
-        }
-        s.f = sum;
-    }
+    if (!specular)
+        s.f = sumF(wo, ls.wi, glm::dot(s.wi, ng_) * glm::dot(woWorld, ng_) > 0.f, flags);
     return s;
 }
 

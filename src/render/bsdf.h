@@ -73,6 +73,10 @@ class BSDF {
     float pdf(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags = BxDFFlags::All) const;
 
   private:
+    // Sum of the matching lobes' f for local directions: reflection lobes if `reflect` (the
+    // geometric normal's verdict on the world directions), else transmission lobes.
+    Spectrum sumF(const Vec3& wo, const Vec3& wi, bool reflect, BxDFFlags flags) const;
+
     Frame frame_;
     Vec3 ng_{0.f, 0.f, 1.f};
     float eta_ = 1.f;
