@@ -6,7 +6,9 @@
 Per scene and configuration: relMSE at the common end time (the shortest run's last pass,
 log-log interpolation of each curve), its ratio to `none`, the break-even time (from when on
 the configuration's curve stays below none's), the overhead per sample (seconds per spp
-relative to none), the zero-contribution fraction, mean path length and guide memory.
+relative to none) and per path vertex (the same divided by the mean path lengths' ratio:
+what a vertex costs, apart from paths that grow or shrink), the zero-contribution fraction,
+mean path length and guide memory.
 With --plots: OUTDIR/curves.png (relMSE against seconds, log-log, one panel per scene) and
 OUTDIR/images.png (the final images side by side with the reference, all at equal time;
 needs build/rlpbrt-imgtool to convert EXR to PNG).
@@ -72,8 +74,9 @@ def main():
                 stats = json.load(f)
         runs.setdefault(scene, {})[config] = (read_curve(path), stats)
     print("| scene | config | spp | relMSE at equal time | ratio to none | break-even s "
-          "| overhead/sample | zero-contribution | mean path length | guide MiB |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "| overhead/sample | overhead/vertex | zero-contribution | mean path length "
+          "| guide MiB |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for scene, configs in runs.items():
         curves = [c for c, _ in configs.values() if c]
         if not curves:
@@ -83,6 +86,7 @@ def main():
         base_e = interp(base_curve, t_end) if base_curve else None
         base_sps = (base_stats["seconds"] / base_stats["spp"]
                     if base_stats.get("spp") else None)
+        base_len = base_stats.get("mean_path_length")
         order = sorted(configs, key=lambda k: (k != "none", k))
         for config in order:
             curve, st = configs[config]
@@ -91,15 +95,18 @@ def main():
             be = break_even(curve, base_curve) if config != "none" and base_curve else None
             sps = st["seconds"] / st["spp"] if st.get("spp") else None
             over = sps / base_sps - 1 if sps and base_sps else None
+            length = st.get("mean_path_length")
+            over_v = ((sps / length) / (base_sps / base_len) - 1
+                      if sps and base_sps and length and base_len else None)
             fmt = lambda v, f: ("-" if v is None else f.format(v))
-            print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
+            print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
                 scene.split("__")[0], config, st.get("spp", "-"), fmt(e, "{:.4g}"),
                 fmt(ratio, "{:.2f}"),
                 ("never" if config != "none" and be is None and base_curve else fmt(be, "{:.2g}")),
-                fmt(over, "{:+.0%}"), fmt(st.get("zero_contribution_fraction"), "{:.3f}"),
+                fmt(over, "{:+.0%}"), fmt(over_v, "{:+.0%}"), fmt(st.get("zero_contribution_fraction"), "{:.3f}"),
                 fmt(st.get("mean_path_length"), "{:.2f}"),
                 fmt(st.get("guide_bytes", 0) / 2**20 if st else None, "{:.1f}")))
-        print("| | equal time: {:.1f} s | | | | | | | | |".format(t_end))
+        print("| | equal time: {:.1f} s | | | | | | | | | |".format(t_end))
     if not plots:
         return
     try:
