@@ -6,9 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -787,28 +784,13 @@ TEST(HemiField, DeterministicAcrossThreadSchedules) {
                 const SlotRecords& r = recs[size_t(s)];
                 for (size_t i = 0; i < r.t.size(); ++i) f->record(s, r.region[i], r.w[i], r.t[i]);
             };
-            if (schedule == 0) {
-                for (int s = 0; s < slots; ++s) feed(s);
-            } else if (schedule == 1) {
-                for (int s = slots - 1; s >= 0; --s) feed(s);
-            } else {
-                tbb::task_arena arena(schedule);
-                arena.execute([&] { tbb::parallel_for(0, slots, 1, feed); });
-            }
+            test::feedSlots(slots, schedule, feed);
             f->endPass();
         }
         return f;
     };
     auto a = run(0), b = run(1), c = run(2), d = run(4);
-    for (const auto* other : {b.get(), c.get(), d.get()}) {
-        ASSERT_EQ(a->qTable().size(), other->qTable().size());
-        EXPECT_EQ(0, std::memcmp(a->qTable().data(), other->qTable().data(),
-                                 a->qTable().size() * sizeof(double)));
-        EXPECT_EQ(0, std::memcmp(a->visitTable().data(), other->visitTable().data(),
-                                 a->visitTable().size() * sizeof(uint64_t)));
-        EXPECT_EQ(0, std::memcmp(a->cdfTable().data(), other->cdfTable().data(),
-                                 a->cdfTable().size() * sizeof(float)));
-    }
+    for (const auto* other : {b.get(), c.get(), d.get()}) test::expectSameTables(*a, *other);
     EXPECT_EQ(a->stats().records, d->stats().records);
     EXPECT_GT(a->stats().records, 0u);
 }

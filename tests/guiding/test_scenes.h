@@ -1,12 +1,16 @@
 // Small analytic scenes and random directions shared by the guiding backends' tests.
 #pragma once
 
+#include <cstring>
 #include <map>
 #include <memory>
 #include <random>
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "guiding/guiding.h"
 
@@ -87,6 +91,34 @@ inline void trainBright(GuidingField& f, int region, const glm::vec3& bright, in
         }
         f.endPass();
     }
+}
+
+// Calls feed(slot) for slots 0 .. slots - 1 in one of the orders the determinism tests
+// compare: schedule 0 = slot order, 1 = reverse order, n >= 2 = in parallel on n threads.
+template <class Feed>
+void feedSlots(int slots, int schedule, Feed&& feed) {
+    if (schedule == 0) {
+        for (int s = 0; s < slots; ++s) feed(s);
+    } else if (schedule == 1) {
+        for (int s = slots - 1; s >= 0; --s) feed(s);
+    } else {
+        tbb::task_arena arena(schedule);
+        arena.execute([&] { tbb::parallel_for(0, slots, 1, feed); });
+    }
+}
+
+// Expects b's learned tables (Q, visits, CDFs) to equal a's bit for bit.
+template <class Field>
+void expectSameTables(const Field& a, const Field& b) {
+    ASSERT_EQ(a.qTable().size(), b.qTable().size());
+    EXPECT_EQ(0, std::memcmp(a.qTable().data(), b.qTable().data(),
+                             a.qTable().size() * sizeof(double)));
+    ASSERT_EQ(a.visitTable().size(), b.visitTable().size());
+    EXPECT_EQ(0, std::memcmp(a.visitTable().data(), b.visitTable().data(),
+                             a.visitTable().size() * sizeof(uint64_t)));
+    ASSERT_EQ(a.cdfTable().size(), b.cdfTable().size());
+    EXPECT_EQ(0, std::memcmp(a.cdfTable().data(), b.cdfTable().data(),
+                             a.cdfTable().size() * sizeof(float)));
 }
 
 }  // namespace rlpbrt::guiding::test

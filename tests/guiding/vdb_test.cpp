@@ -9,7 +9,6 @@
 #include <gtest/gtest.h>
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -435,28 +434,13 @@ TEST(VdbField, DeterministicMergeAcrossThreadSchedules) {
             auto feed = [&](int s) {
                 for (const auto& [r, w, t] : recs[size_t(s)]) f->record(s, r, w, t);
             };
-            if (schedule == 0) {
-                for (int s = 0; s < slots; ++s) feed(s);
-            } else if (schedule == 1) {
-                for (int s = slots - 1; s >= 0; --s) feed(s);
-            } else {
-                tbb::task_arena arena(schedule);
-                arena.execute([&] { tbb::parallel_for(0, slots, 1, feed); });
-            }
+            test::feedSlots(slots, schedule, feed);
             f->endPass();
         }
         return f;
     };
     auto a = run(0), b = run(1), c = run(2), d = run(4);
-    for (const auto* o : {b.get(), c.get(), d.get()}) {
-        ASSERT_EQ(a->qTable().size(), o->qTable().size());
-        EXPECT_EQ(0, std::memcmp(a->qTable().data(), o->qTable().data(),
-                                 a->qTable().size() * sizeof(double)));
-        EXPECT_EQ(0, std::memcmp(a->visitTable().data(), o->visitTable().data(),
-                                 a->visitTable().size() * sizeof(uint64_t)));
-        EXPECT_EQ(0, std::memcmp(a->cdfTable().data(), o->cdfTable().data(),
-                                 a->cdfTable().size() * sizeof(float)));
-    }
+    for (const auto* o : {b.get(), c.get(), d.get()}) test::expectSameTables(*a, *o);
     EXPECT_GT(a->stats().records, 0u);
 }
 
@@ -473,10 +457,7 @@ void trainAll(GuidingField& f, int regions, uint64_t seed) {
 template <class Field>
 void expectSamePolicy(const Field& a, const Field& b) {
     ASSERT_EQ(a.numRegions(), b.numRegions());
-    EXPECT_EQ(a.qTable(), b.qTable());
-    EXPECT_EQ(a.visitTable(), b.visitTable());
-    EXPECT_EQ(0, std::memcmp(a.cdfTable().data(), b.cdfTable().data(),
-                             a.cdfTable().size() * sizeof(float)));
+    test::expectSameTables(a, b);
     std::mt19937_64 rng(77);
     std::uniform_int_distribution<int> reg(0, a.numRegions() - 1);
     for (int i = 0; i < 20000; ++i) {
