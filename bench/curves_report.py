@@ -103,7 +103,8 @@ def main():
                 scene.split("__")[0], config, st.get("spp", "-"), fmt(e, "{:.4g}"),
                 fmt(ratio, "{:.2f}"),
                 ("never" if config != "none" and be is None and base_curve else fmt(be, "{:.2g}")),
-                fmt(over, "{:+.0%}"), fmt(over_v, "{:+.0%}"), fmt(st.get("zero_contribution_fraction"), "{:.3f}"),
+                fmt(over, "{:+.0%}"), fmt(over_v, "{:+.0%}"),
+                fmt(st.get("zero_contribution_fraction"), "{:.3f}"),
                 fmt(st.get("mean_path_length"), "{:.2f}"),
                 fmt(st.get("guide_bytes", 0) / 2**20 if st else None, "{:.1f}")))
         print("| | equal time: {:.1f} s | | | | | | | | | |".format(t_end))
