@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# A/B speed of two rlpbrt binaries (or two option sets) on one scene, robust to a shared VM:
+#   bench/ab.sh BIN_A BIN_B SCENE [PAIRS] [SPP] -- [rlpbrt options...]
+# Runs PAIRS (default 8) pairs: A and B render the same SCENE (a path, or a scene id of
+# ../shared/references/manifest.tsv) at the same time, one thread each, pinned to cores 0 and
+# 1, swapping the cores every pair, each for SPP samples per pixel (default 128). Prints each
+# pair's ratio of render seconds B / A and their geometric mean with a 95% interval (t
+# distribution over the log ratios). Pairs, not sequential runs: the VM's speed drifts by up
+# to 40% between minutes, but the two renders of a pair share it. A ratio's interval that
+# contains 1 is no difference. Environment: OPTS_A / OPTS_B (extra options for one side),
+# SHARED (default ../shared), SEED (default 3).
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+shared=${SHARED:-$here/../shared}
+usage="usage: $0 BIN_A BIN_B SCENE [PAIRS] [SPP] -- [options...]"
+a=${1:?$usage}
+b=${2:?$usage}
+scene=${3:?$usage}
+shift 3
+pairs=8
+spp=128
+[[ $# -gt 0 && $1 != -- ]] && { pairs=$1; shift; }
+[[ $# -gt 0 && $1 != -- ]] && { spp=$1; shift; }
+[[ $# -gt 0 && $1 == -- ]] && shift
+if [[ ! -f $scene ]]; then
+    path=$(awk -F'\t' -v id="$scene" '$1 == id { print $2 }' "$shared/references/manifest.tsv")
+    [[ -n $path ]] || { echo "$0: no scene file or manifest id '$scene'" >&2; exit 2; }
+    scene=$shared/scenes/$path
+fi
+[[ $(nproc) -ge 2 ]] || { echo "$0: needs two cores" >&2; exit 2; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+run() {  # core binary tag extra-options
+    # shellcheck disable=SC2086
+    taskset -c "$1" "$2" "$scene" --spp "$spp" --nthreads 1 --quiet --seed "${SEED:-3}" \
+        -o "$tmp/$3.exr" --stats "$tmp/$3.json" "${@:5}" $4 >/dev/null 2>"$tmp/$3.log"
+}
+ratios=()
+for ((i = 0; i < pairs; i++)); do
+    ca=$((i % 2)); cb=$((1 - i % 2))
+    run "$ca" "$a" A "${OPTS_A:-}" "$@" &
+    pa=$!
+    run "$cb" "$b" B "${OPTS_B:-}" "$@" &
+    pb=$!
+    wait "$pa" || { cat "$tmp/A.log" >&2; exit 1; }
+    wait "$pb" || { cat "$tmp/B.log" >&2; exit 1; }
+    r=$(/usr/bin/python3 -c 'import json,sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+print("%.4f" % (b["seconds"] / a["seconds"]))' "$tmp/A.json" "$tmp/B.json")
+    echo "pair $((i + 1)) (A on core $ca): B / A = $r"
+    ratios+=("$r")
+done
+/usr/bin/python3 - "${ratios[@]}" <<'EOF'
+import math, sys
+logs = [math.log(float(r)) for r in sys.argv[1:]]
+n = len(logs)
+mean = sum(logs) / n
+if n > 1:
+    sd = math.sqrt(sum((x - mean) ** 2 for x in logs) / (n - 1))
+    # Two-sided 95% t quantiles for n - 1 degrees of freedom (1..30; beyond: normal).
+    t = [12.71, 4.30, 3.18, 2.78, 2.57, 2.45, 2.36, 2.31, 2.26, 2.23, 2.20, 2.18, 2.16, 2.14,
+         2.13, 2.12, 2.11, 2.10, 2.09, 2.09, 2.08, 2.07, 2.07, 2.06, 2.06, 2.06, 2.05, 2.05,
+         2.05, 2.04]
+    q = t[n - 2] if n - 2 < len(t) else 1.96
+    half = q * sd / math.sqrt(n)
+    print("B / A seconds: %.4f (95%%: %.4f .. %.4f, %d pairs)" %
+          (math.exp(mean), math.exp(mean - half), math.exp(mean + half), n))
+else:
+    print("B / A seconds: %.4f (1 pair)" % math.exp(mean))
+EOF
