@@ -76,7 +76,9 @@ bool badValue(const char* backend, const std::string& key, const std::string& va
     return false;
 }
 
-// A strata value, "WxH" or "N" (N x N), with integers in 1..64; false if it is anything else.
+// A strata value, "WxH" or "N" (N x N), with integers in 1..64; false if it is anything else
+// (then kStrataExpected says what was expected).
+constexpr const char* kStrataExpected = "WxH or N with integers in 1..64";
 bool parseStrata(const std::string& value, int* cols, int* rows) {
     const size_t x = value.find_first_of("xX");
     uint64_t w = 0, h = 0;
@@ -115,7 +117,7 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
         }
     } else if (key == "strata") {
         if (!parseStrata(value, &p->cols, &p->rows))
-            return bad("WxH or N with integers in 1..64");
+            return bad(kStrataExpected);
     } else if (key == "points") {
         if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
             return bad("an integer in 1..67108864");
@@ -217,7 +219,7 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
             vp->volume = value == "1";
         } else if (key == "volume-strata") {
             if (!parseStrata(value, &vp->volumeCols, &vp->volumeRows))
-                return badValue("vdb", key, value, "WxH or N with integers in 1..64", error);
+                return badValue("vdb", key, value, kStrataExpected, error);
         } else if (key == "volume-warmup") {
             if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
                 return badValue("vdb", key, value, "a number in [0, 1e9]", error);
