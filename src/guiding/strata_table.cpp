@@ -53,67 +53,83 @@ void StrataTable::assign(std::vector<double> q, std::vector<uint64_t> visits,
 }
 
 void StrataTable::setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior) {
-    levels_.clear();
-    levelSize_.clear();
+    parent_.clear();
+    nodes_ = 0;
     prior_ = prior > 0.0 && std::isfinite(prior) ? prior : 0.0;
-    if (prior_ == 0.0) return;
-    levels_ = std::move(levels);
-    for (const std::vector<uint32_t>& map : levels_) {
+    if (prior_ == 0.0 || levels.empty()) return;
+    // Number the nodes above the strata level by level (level 1 first, the root last) and
+    // keep one parent index per stratum and node: the strata's parents are nodes, a node's
+    // parent is a node of the next level, and the top level's nodes have none.
+    std::vector<uint32_t> offset(levels.size() + 1, 0);
+    for (size_t l = 0; l < levels.size(); ++l) {
         uint32_t size = 0;
-        for (uint32_t parent : map) size = std::max(size, parent + 1);
-        levelSize_.push_back(size);
+        for (uint32_t parent : levels[l]) size = std::max(size, parent + 1);
+        offset[l + 1] = offset[l] + size;
     }
+    nodes_ = offset.back();
+    parent_.assign(levels[0].begin(), levels[0].end());
+    parent_.resize(levels[0].size() + nodes_, kNoParent);
+    for (size_t l = 1; l < levels.size(); ++l)
+        for (size_t i = 0; i < levels[l].size(); ++i)
+            parent_[levels[0].size() + offset[l - 1] + i] = offset[l] + levels[l][i];
 }
 
-void StrataTable::estimate(size_t region, double* out) const {
+void StrataTable::estimate(size_t region, double* out, double* scratch) const {
     const double* q = this->q(region);
-    if (levels_.empty()) {
+    if (parent_.empty()) {
         std::copy(q, q + strata_, out);
         return;
     }
     const uint64_t* v = visits(region);
-    // Per node above the strata (level by level, offsets into one buffer): the visits under
-    // it, the sum of their targets and its estimate.
-    const size_t levels = levels_.size();
-    std::vector<size_t> offset(levels + 1, 0);
-    for (size_t l = 0; l < levels; ++l) offset[l + 1] = offset[l] + levelSize_[l];
-    const size_t nodes = offset[levels];
-    std::vector<double> buf(3 * nodes, 0.0);
-    double *sum = buf.data(), *count = sum + nodes, *est = count + nodes;
-    // Bottom-up: strata into level 1, each level into the next.
-    for (size_t l = 0; l < levels; ++l) {
-        const std::vector<uint32_t>& map = levels_[l];
-        for (size_t i = 0; i < map.size(); ++i) {
-            const size_t parent = offset[l] + map[i];
-            sum[parent] += l == 0 ? double(v[i]) * q[i] : sum[offset[l - 1] + i];
-            count[parent] += l == 0 ? double(v[i]) : count[offset[l - 1] + i];
-        }
+    // Per node above the strata: the visits under it, the sum of their targets and its
+    // estimate.
+    std::vector<double> local;
+    if (!scratch) {
+        local.resize(smoothingScratch());
+        scratch = local.data();
+    }
+    const size_t nodes = nodes_, n = size_t(strata_);
+    double *sum = scratch, *count = sum + nodes, *est = count + nodes;
+    std::fill(scratch, scratch + 2 * nodes, 0.0);
+    const uint32_t* up = parent_.data();
+    // Bottom-up: the strata into their nodes, then each node (children before parents) into
+    // its parent.
+    // (Visit counts stay far below 2^63: converted as signed, one instruction.)
+    for (size_t j = 0; j < n; ++j) {
+        const double c = double(int64_t(v[j]));
+        sum[up[j]] += c * q[j];
+        count[up[j]] += c;
+    }
+    const uint32_t* nodeUp = up + n;
+    for (size_t k = 0; k < nodes; ++k) {
+        if (nodeUp[k] == kNoParent) continue;
+        sum[nodeUp[k]] += sum[k];
+        count[nodeUp[k]] += count[k];
     }
     // Top-down: each node shrunk towards its parent's estimate. The root takes the mean of
     // all its targets (init before any): a prior of init there would pull every estimate
     // towards a scale unrelated to the scene's radiance.
-    for (size_t l = levels; l-- > 0;) {
-        for (size_t i = 0; i < levelSize_[l]; ++i) {
-            const size_t node = offset[l] + i;
-            if (l + 1 == levels) {
-                est[node] = count[node] > 0.0 ? sum[node] / count[node] : init_;
-                continue;
-            }
-            const double parent = est[offset[l + 1] + levels_[l + 1][i]];
-            est[node] = (sum[node] + prior_ * parent) / (count[node] + prior_);
-        }
+    for (size_t k = nodes; k-- > 0;) {
+        if (nodeUp[k] == kNoParent)
+            est[k] = count[k] > 0.0 ? sum[k] / count[k] : init_;
+        else
+            est[k] = (sum[k] + prior_ * est[nodeUp[k]]) / (count[k] + prior_);
     }
-    for (int j = 0; j < strata_; ++j) {
-        const double parent = est[levels_[0][size_t(j)]];
-        const double n = double(v[j]);
-        out[j] = (n * q[j] + prior_ * parent) / (n + prior_);
+    for (size_t j = 0; j < n; ++j) {
+        const double c = double(int64_t(v[j]));
+        out[j] = (c * q[j] + prior_ * est[up[j]]) / (c + prior_);
     }
 }
 
-void StrataTable::rebuild(size_t region, const PolicyBuilder& policy) {
-    std::vector<double> e(static_cast<size_t>(strata_));
-    estimate(region, e.data());
-    policy(int(region), e.data(), &cdf_[region * size_t(strata_ + 1)]);
+void StrataTable::rebuild(size_t region, const PolicyBuilder& policy, double* scratch) {
+    std::vector<double> local;
+    if (!scratch) {
+        local.resize(size_t(strata_) + smoothingScratch());
+        scratch = local.data();
+    }
+    double* e = scratch;
+    estimate(region, e, scratch + strata_);
+    policy(int(region), e, &cdf_[region * size_t(strata_ + 1)]);
     float* out = &est_[region * size_t(strata_)];
     for (int j = 0; j < strata_; ++j) out[j] = float(std::min(e[j], double(FLT_MAX)));
 }
@@ -130,7 +146,7 @@ void StrataTable::beginPass(int numSlots) {
 
 void StrataTable::applyRegion(size_t region, const Record* begin, const Record* end,
                               bool alphaVisits, double fixedAlpha, double* sums,
-                              uint64_t* counts, const PolicyBuilder& policy) {
+                              uint64_t* counts, double* scratch, const PolicyBuilder& policy) {
     std::fill(sums, sums + strata_, 0.0);
     std::fill(counts, counts + strata_, uint64_t(0));
     for (const Record* r = begin; r != end; ++r) {  // merge order: slot, then record order
@@ -156,7 +172,7 @@ void StrataTable::applyRegion(size_t region, const Record* begin, const Record* 
         q[j] = (std::isfinite(updated) && updated >= 0.0) ? updated : mean;
         visits[j] += m;
     }
-    rebuild(region, policy);
+    rebuild(region, policy, scratch);
 }
 
 void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy) {
@@ -180,13 +196,15 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
                           [&](const tbb::blocked_range<size_t>& range) {
                               std::vector<double> sums(static_cast<size_t>(strata_));
                               std::vector<uint64_t> counts(static_cast<size_t>(strata_));
+                              std::vector<double> scratch(size_t(strata_) +
+                                                          smoothingScratch());
                               for (size_t r = range.begin(); r != range.end(); ++r) {
                                   size_t b = r == 0 ? 0 : regionStart_[r - 1];
                                   size_t e = regionStart_[r];
                                   if (b == e) continue;
                                   applyRegion(r, merged_.data() + b, merged_.data() + e,
                                               alphaVisits, fixedAlpha, sums.data(),
-                                              counts.data(), policy);
+                                              counts.data(), scratch.data(), policy);
                               }
                           });
     }

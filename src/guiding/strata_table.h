@@ -49,8 +49,10 @@ public:
     // that continue each pixel's sequence, docs/STABILITY.md). prior 0 or no levels: the
     // estimates are Q. Call before reset()/grow()/assign() build the policy.
     void setSmoothing(std::vector<std::vector<uint32_t>> levels, double prior);
-    // The (unrounded) estimates of one region, strata doubles.
-    void estimate(size_t region, double* out) const;
+    // The (unrounded) estimates of one region, strata doubles. `scratch` (optional) holds
+    // smoothingScratch() doubles.
+    void estimate(size_t region, double* out, double* scratch = nullptr) const;
+    size_t smoothingScratch() const { return 3 * size_t(nodes_); }
     const uint64_t* visits(size_t region) const { return &visits_[region * size_t(strata_)]; }
     const float* cdf(size_t region) const { return &cdf_[region * size_t(strata_ + 1)]; }
 
@@ -61,7 +63,7 @@ public:
         if (!(w > 0.0)) return 1.f;
         const uint64_t* v = visits(region);
         double total = 0.0;
-        for (int j = 0; j < strata_; ++j) total += double(v[j]);
+        for (int j = 0; j < strata_; ++j) total += double(int64_t(v[j]));  // < 2^63
         return float(total / (total + w));
     }
 
@@ -121,17 +123,21 @@ private:
         uint64_t rejectedRecords = 0;
     };
     void applyRegion(size_t region, const Record* begin, const Record* end, bool alphaVisits,
-                     double fixedAlpha, double* sums, uint64_t* counts,
+                     double fixedAlpha, double* sums, uint64_t* counts, double* scratch,
                      const PolicyBuilder& policy);
-    // Rebuilds a region's estimates and its CDF.
-    void rebuild(size_t region, const PolicyBuilder& policy);
+    // Rebuilds a region's estimates and its CDF; `scratch` (optional) holds strata +
+    // smoothingScratch() doubles.
+    void rebuild(size_t region, const PolicyBuilder& policy, double* scratch = nullptr);
 
     size_t regions_ = 0;
     int strata_ = 0;
     std::vector<double> q_;
     std::vector<float> est_;
-    std::vector<std::vector<uint32_t>> levels_;  // setSmoothing's tree (empty: none)
-    std::vector<uint32_t> levelSize_;            // nodes per level above the strata
+    // setSmoothing's tree, flattened (empty: no smoothing): the parent node of each stratum,
+    // then of each of the nodes_ nodes above the strata (level by level, the root last).
+    static constexpr uint32_t kNoParent = UINT32_MAX;
+    std::vector<uint32_t> parent_;
+    uint32_t nodes_ = 0;
     double prior_ = 0.0;
     double init_ = 0.0;  // reset()'s initial Q
     std::vector<uint64_t> visits_;
