@@ -84,7 +84,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     for (size_t r = 0; r < regions; ++r) frames_[r].frame = HemiFrame::fromZ(regionNormal(int(r)));
     if (params.smooth > 0.0)
         table_.setSmoothing(layout_.quadtree(), params.smooth);
-    table_.reset(regions, strata_, params.init, policy());
+    table_.reset(regions, strata_, params.init, policy(), /*lazy=*/true);
     // (reset built region 0 and copied it to the others)
     if (regions > 0) {
         std::vector<double> est(static_cast<size_t>(strata_));
@@ -277,13 +277,14 @@ std::string HemiField::describe() const {
                   "hemi: %zu points (%d hemispheres, %llu draws), %dx%d strata, alpha=%s, "
                   "normal-angle=%g, knn=%d, init=%g, epsilon=%g, warmup=%g, smooth=%g, "
                   "%.1f MiB (+%.1f MiB record "
-                  "buffers); passes=%llu, records=%llu, rejected targets=%llu, "
+                  "buffers; %zu hemispheres with tables of their own, the others share the untrained one); "
+                  "passes=%llu, records=%llu, rejected targets=%llu, "
                   "rejected records=%llu",
                   positions_.size(), numRegions(), (unsigned long long)attempts_, params_.cols,
                   params_.rows, alpha, params_.normalAngleDeg, params_.knn, params_.init,
                   params_.epsilon, params_.warmup, params_.smooth,
                   double(bytes()) / (1024.0 * 1024.0),
-                  double(scratchBytes()) / (1024.0 * 1024.0),
+                  double(scratchBytes()) / (1024.0 * 1024.0), learnedRegions(),
                   (unsigned long long)stats().passes, (unsigned long long)stats().records,
                   (unsigned long long)stats().rejectedTargets,
                   (unsigned long long)stats().rejectedRecords);
@@ -302,7 +303,11 @@ std::string HemiField::describe() const {
     return line;
 }
 
-GuidingStats HemiField::stats() const { return table_.stats(); }
+GuidingStats HemiField::stats() const {
+    GuidingStats s = table_.stats();
+    s.learnedRegions = learnedRegions();
+    return s;
+}
 
 bool HemiField::save(const std::string& path, std::string* error) const {
     fieldio::Writer w;
@@ -322,9 +327,13 @@ bool HemiField::save(const std::string& path, std::string* error) const {
     w.u64(st.rejectedTargets);
     w.u64(st.rejectedRecords);
     w.u64(uint64_t(numRegions()));
-    w.data.reserve(w.data.size() + table_.qTable().size() * 16);
-    for (double q : table_.qTable()) w.f64(q);
-    for (uint64_t v : table_.visitTable()) w.u64(v);
+    // Region-major, every region (those still on the prior write its Q and visits).
+    const size_t regions = size_t(numRegions()), n = size_t(strata_);
+    w.data.reserve(w.data.size() + regions * n * 16);
+    for (size_t reg = 0; reg < regions; ++reg)
+        for (size_t j = 0; j < n; ++j) w.f64(table_.q(reg)[j]);
+    for (size_t reg = 0; reg < regions; ++reg)
+        for (size_t j = 0; j < n; ++j) w.u64(table_.visits(reg)[j]);
     if (!fieldio::writeFile(path, w.data, error)) return false;
     return true;
 }
@@ -372,7 +381,7 @@ bool HemiField::load(const std::string& path, std::string* error) {
         return fail("strata " + std::to_string(cols) + "x" + std::to_string(rows) +
                     ", this field has " + std::to_string(params_.cols) + "x" +
                     std::to_string(params_.rows));
-    const size_t count = table_.qTable().size();
+    const size_t count = size_t(numRegions()) * size_t(strata_);
     if (r.remaining() != count * 16) return fail("table size does not match the header");
     std::vector<double> q(count);
     std::vector<uint64_t> visits(count);

@@ -120,6 +120,9 @@ public:
     // Inspection (tests, tools).
     // Bytes of the per-pass record buffers and endPass scratch (not counted in bytes()).
     size_t scratchBytes() const;
+    // Regions that have received records and hold tables of their own (the others share the
+    // untrained prior's).
+    size_t learnedRegions() const { return table_.learnedRegions(); }
     // Number of regions (hemispheres): twice the number of accepted surface points.
     int numRegions() const { return static_cast<int>(normals_.size() * 2); }
     const StrataLayout& layout() const { return layout_; }

@@ -11,21 +11,32 @@
 
 namespace rlpbrt::guiding {
 
-void StrataTable::reset(size_t regions, int strata, double init, const PolicyBuilder& policy) {
+void StrataTable::reset(size_t regions, int strata, double init, const PolicyBuilder& policy,
+                        bool lazy) {
     regions_ = regions;
     strata_ = strata;
     init_ = init;
+    lazy_ = lazy;
     const size_t n = size_t(strata);
-    q_.assign(regions * n, init);
-    est_.assign(regions * n, float(std::min(init, double(FLT_MAX))));
-    visits_.assign(regions * n, 0);
-    cdf_.assign(regions * (n + 1), 0.f);
+    // Lazy: one block, the prior, shared by every region until it learns. Else one block per
+    // region.
+    blocks_ = lazy ? (regions > 0 ? 1 : 0) : regions;
+    block_.resize(regions);
+    for (size_t r = 0; r < regions; ++r) block_[r] = lazy ? 0 : uint32_t(r);
+    q_.assign(blocks_ * n, init);
+    est_.assign(blocks_ * n, float(std::min(init, double(FLT_MAX))));
+    visits_.assign(blocks_ * n, 0);
+    cdf_.assign(blocks_ * (n + 1), 0.f);
+    q_.shrink_to_fit();
+    est_.shrink_to_fit();
+    visits_.shrink_to_fit();
+    cdf_.shrink_to_fit();
     // Every region starts with the same Q and no visits: build the first one and copy it.
     if (regions > 0) {
         rebuild(0, policy);
-        for (size_t r = 1; r < regions; ++r) {
-            std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(r * (n + 1)));
-            std::copy(est_.begin(), est_.begin() + long(n), est_.begin() + long(r * n));
+        for (size_t b = 1; b < blocks_; ++b) {
+            std::copy(cdf_.begin(), cdf_.begin() + long(n + 1), cdf_.begin() + long(b * (n + 1)));
+            std::copy(est_.begin(), est_.begin() + long(n), est_.begin() + long(b * n));
         }
     }
     slots_.clear();
@@ -38,6 +49,14 @@ void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy)
     const size_t n = size_t(strata_), old = regions_;
     regions_ = regions;
     selection_.grow(regions);
+    if (lazy_) {
+        if (blocks_ == 0) return;  // (reset with no regions: no prior block to share)
+        block_.resize(regions, 0);
+        return;
+    }
+    block_.resize(regions);
+    for (size_t r = old; r < regions; ++r) block_[r] = uint32_t(r);
+    blocks_ = regions;
     q_.resize(regions * n, init);
     est_.resize(regions * n, float(std::min(init, double(FLT_MAX))));
     visits_.resize(regions * n, 0);
@@ -45,10 +64,67 @@ void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy)
     for (size_t r = old; r < regions; ++r) rebuild(r, policy);
 }
 
+void StrataTable::addBlocks(const std::vector<size_t>& regions,
+                            const std::vector<const double*>& q,
+                            const std::vector<const uint64_t*>& visits) {
+    const size_t n = size_t(strata_), k = regions.size(), total = blocks_ + k;
+    // Exact capacities: the tables are the guide's memory, and reported as such.
+    q_.reserve(total * n);
+    visits_.reserve(total * n);
+    est_.reserve(total * n);
+    cdf_.reserve(total * (n + 1));
+    // The prior block (block 0), copied out: insert() may not read from its own vector.
+    const std::vector<double> priorQ(q_.begin(), q_.begin() + long(n));
+    const std::vector<uint64_t> priorVisits(visits_.begin(), visits_.begin() + long(n));
+    const std::vector<float> priorEst(est_.begin(), est_.begin() + long(n));
+    const std::vector<float> priorCdf(cdf_.begin(), cdf_.begin() + long(n + 1));
+    for (size_t i = 0; i < k; ++i) {
+        // From the given data, or else the prior's.
+        const double* qi = q[i] ? q[i] : priorQ.data();
+        const uint64_t* vi = visits[i] ? visits[i] : priorVisits.data();
+        q_.insert(q_.end(), qi, qi + n);
+        visits_.insert(visits_.end(), vi, vi + n);
+        est_.insert(est_.end(), priorEst.begin(), priorEst.end());
+        cdf_.insert(cdf_.end(), priorCdf.begin(), priorCdf.end());
+        block_[regions[i]] = uint32_t(blocks_ + i);
+    }
+    blocks_ = total;
+}
+
 void StrataTable::assign(std::vector<double> q, std::vector<uint64_t> visits,
                          const PolicyBuilder& policy) {
-    q_ = std::move(q);
-    visits_ = std::move(visits);
+    const size_t n = size_t(strata_);
+    if (!lazy_) {
+        q_ = std::move(q);
+        visits_ = std::move(visits);
+    } else if (regions_ > 0) {
+        // Keep the prior block; every region that has learned anything gets a block again.
+        q_.resize(n);
+        visits_.resize(n);
+        est_.resize(n);
+        cdf_.resize(n + 1);
+        blocks_ = 1;
+        std::vector<size_t> learned;
+        std::vector<const double*> qs;
+        std::vector<const uint64_t*> vs;
+        for (size_t r = 0; r < regions_; ++r) {
+            block_[r] = 0;
+            const double* qr = &q[r * n];
+            const uint64_t* vr = &visits[r * n];
+            bool prior = true;
+            for (size_t j = 0; j < n && prior; ++j) prior = vr[j] == 0 && qr[j] == init_;
+            if (prior) continue;
+            learned.push_back(r);
+            qs.push_back(qr);
+            vs.push_back(vr);
+        }
+        q_.shrink_to_fit();
+        visits_.shrink_to_fit();
+        est_.shrink_to_fit();
+        cdf_.shrink_to_fit();
+        addBlocks(learned, qs, vs);
+    }
+    // (A region on the prior block rebuilds the prior, unchanged, and its own policy data.)
     for (size_t r = 0; r < regions_; ++r) rebuild(r, policy);
 }
 
@@ -129,8 +205,8 @@ void StrataTable::rebuild(size_t region, const PolicyBuilder& policy, double* sc
     }
     double* e = scratch;
     estimate(region, e, scratch + strata_);
-    policy(int(region), e, &cdf_[region * size_t(strata_ + 1)]);
-    float* out = &est_[region * size_t(strata_)];
+    policy(int(region), e, &cdf_[block_[region] * size_t(strata_ + 1)]);
+    float* out = &est_[block_[region] * size_t(strata_)];
     for (int j = 0; j < strata_; ++j) out[j] = float(std::min(e[j], double(FLT_MAX)));
 }
 
@@ -153,8 +229,8 @@ void StrataTable::applyRegion(size_t region, const Record* begin, const Record* 
         sums[r->stratum] += double(r->target);
         ++counts[r->stratum];
     }
-    double* q = &q_[region * size_t(strata_)];
-    uint64_t* visits = &visits_[region * size_t(strata_)];
+    double* q = &q_[block_[region] * size_t(strata_)];
+    uint64_t* visits = &visits_[block_[region] * size_t(strata_)];
     for (int j = 0; j < strata_; ++j) {
         const uint64_t m = counts[j];
         if (m == 0) continue;
@@ -192,6 +268,18 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
             slots_, [](const SlotBuffer& s) -> const std::vector<Record>& { return s.records; },
             regions_, &regionStart_, &merged_);
         // regionStart_[r] now holds the end of region r.
+        if (lazy_) {
+            // Regions learning for the first time leave the prior for blocks of their own,
+            // appended in region order (deterministic).
+            std::vector<size_t> fresh;
+            for (size_t r = 0; r < regions_; ++r) {
+                const size_t b = r == 0 ? 0 : regionStart_[r - 1];
+                if (regionStart_[r] != b && block_[r] == 0) fresh.push_back(r);
+            }
+            if (!fresh.empty())
+                addBlocks(fresh, std::vector<const double*>(fresh.size(), nullptr),
+                          std::vector<const uint64_t*>(fresh.size(), nullptr));
+        }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, regions_, 256),
                           [&](const tbb::blocked_range<size_t>& range) {
                               std::vector<double> sums(static_cast<size_t>(strata_));
@@ -217,7 +305,7 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
 size_t StrataTable::bytes() const {
     return q_.capacity() * sizeof(double) + est_.capacity() * sizeof(float) +
            visits_.capacity() * sizeof(uint64_t) + cdf_.capacity() * sizeof(float) +
-           selection_.bytes();
+           block_.capacity() * sizeof(uint32_t) + selection_.bytes();
 }
 
 size_t StrataTable::scratchBytes() const {

@@ -24,8 +24,11 @@ public:
     using PolicyBuilder = std::function<void(int region, const double* q, float* cdf)>;
 
     // regions x strata entries, every Q = init, no visits; CDFs built with `policy` (which
-    // must depend on Q only: the first region's CDF is copied to all).
-    void reset(size_t regions, int strata, double init, const PolicyBuilder& policy);
+    // must depend on Q only: the first region's CDF is copied to all). Lazy: the regions share
+    // one block of tables (the prior) until their first records, when endPass gives them
+    // blocks of their own, so that memory follows the regions a scene's paths reach.
+    void reset(size_t regions, int strata, double init, const PolicyBuilder& policy,
+               bool lazy = false);
     // Appends regions (up to `regions` in all) with every Q = init and no visits, keeping
     // the existing ones and the counters; the new CDFs are built with `policy`. Not during a
     // pass (between endPass and beginPass only).
@@ -33,10 +36,12 @@ public:
 
     size_t regions() const { return regions_; }
     int strata() const { return strata_; }
-    const double* q(size_t region) const { return &q_[region * size_t(strata_)]; }
+    const double* q(size_t region) const { return &q_[block_[region] * size_t(strata_)]; }
     // The estimates of a region's strata that queries and the policy use, frozen per pass:
     // Q itself, or with smoothing the shrunken estimates below.
-    const float* estimates(size_t region) const { return &est_[region * size_t(strata_)]; }
+    const float* estimates(size_t region) const {
+        return &est_[block_[region] * size_t(strata_)];
+    }
 
     // Hierarchical smoothing of the estimates (Bayesian shrinkage; off until set): the strata
     // are the leaves of a tree whose levels are given by parent maps (levels[0][j] = the node
@@ -53,8 +58,12 @@ public:
     // smoothingScratch() doubles.
     void estimate(size_t region, double* out, double* scratch = nullptr) const;
     size_t smoothingScratch() const { return 3 * size_t(nodes_); }
-    const uint64_t* visits(size_t region) const { return &visits_[region * size_t(strata_)]; }
-    const float* cdf(size_t region) const { return &cdf_[region * size_t(strata_ + 1)]; }
+    const uint64_t* visits(size_t region) const {
+        return &visits_[block_[region] * size_t(strata_)];
+    }
+    const float* cdf(size_t region) const { return &cdf_[block_[region] * size_t(strata_ + 1)]; }
+    // Regions with tables of their own (all of them unless lazy).
+    size_t learnedRegions() const { return lazy_ ? blocks_ - (blocks_ > 0) : blocks_; }
 
     // Confidence of a region's policy: visits / (visits + warmup * strata) over all its
     // strata (1 for warmup 0), the factor both backends apply to the guide's mixture weight.
@@ -93,7 +102,8 @@ public:
     // rebuilds the CDFs of the regions that received records.
     void endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy);
 
-    // Replaces Q and visits (same sizes; checked by the caller) and rebuilds every CDF.
+    // Replaces Q and visits (regions x strata, region-major; checked by the caller) and
+    // rebuilds every CDF. Lazy: regions whose Q and visits are the prior's share its block.
     void assign(std::vector<double> q, std::vector<uint64_t> visits,
                 const PolicyBuilder& policy);
 
@@ -101,6 +111,7 @@ public:
     SelectionLearner& selection() { return selection_; }
     const SelectionLearner& selection() const { return selection_; }
 
+    // The raw tables, block-major (for bitwise comparisons of fields made alike).
     const std::vector<double>& qTable() const { return q_; }
     const std::vector<uint64_t>& visitTable() const { return visits_; }
     const std::vector<float>& cdfTable() const { return cdf_; }
@@ -125,12 +136,19 @@ private:
     void applyRegion(size_t region, const Record* begin, const Record* end, bool alphaVisits,
                      double fixedAlpha, double* sums, uint64_t* counts, double* scratch,
                      const PolicyBuilder& policy);
+    // Appends a block per region (Q and visits copied from q[i] / visits[i], or from the prior
+    // where null; estimates and CDF the prior's until rebuilt). Not during a pass.
+    void addBlocks(const std::vector<size_t>& regions, const std::vector<const double*>& q,
+                   const std::vector<const uint64_t*>& visits);
     // Rebuilds a region's estimates and its CDF; `scratch` (optional) holds strata +
     // smoothingScratch() doubles.
     void rebuild(size_t region, const PolicyBuilder& policy, double* scratch = nullptr);
 
     size_t regions_ = 0;
     int strata_ = 0;
+    bool lazy_ = false;
+    size_t blocks_ = 0;
+    std::vector<uint32_t> block_;  // per region: its block of q_, est_, visits_, cdf_
     std::vector<double> q_;
     std::vector<float> est_;
     // setSmoothing's tree, flattened (empty: no smoothing): the parent node of each stratum,

@@ -168,15 +168,16 @@ TEST(HemiField, DefaultsAndMemory) {
     EXPECT_TRUE(f->params().alphaVisits);
     EXPECT_EQ(f->params().warmup, 8.0);
     EXPECT_EQ(f->params().smooth, 2.0);
-    // Q (double), estimates (float), visits (uint64), CDF (257 floats), frame and moment per
-    // region dominate.
-    const size_t tables = size_t(f->numRegions()) * (256 * 20 + 257 * 4 + 64);
-    EXPECT_GE(f->bytes(), tables);
+    // Untrained, every region has its frame (one cache line) and block index, and all share
+    // one block of tables: Q (double), estimates (float), visits (uint64), CDF (257 floats).
+    const size_t block = 256 * 20 + 257 * 4;
+    const size_t perRegion = size_t(f->numRegions()) * (64 + 4);
+    EXPECT_GE(f->bytes(), perRegion + block);
     // Points, tree and the lookup's cell memo: 16384 entries of one cache line.
     ASSERT_NE(f->cellCache(), nullptr);
     EXPECT_EQ(f->cellCache()->bytes(), 2048u * 8u * 64u);
-    EXPECT_LE(f->bytes(), tables + 2048 * 64 + f->cellCache()->bytes());
-    EXPECT_LE(double(f->bytes()), 1.05 * hemiEstimatedBytes(f->params()));
+    EXPECT_LE(f->bytes(), perRegion + block + 2048 * 64 + f->cellCache()->bytes());
+    EXPECT_EQ(f->learnedRegions(), 0u);
     EXPECT_FALSE(f->describe().empty());
     // Record buffers are scratch, reported apart from the learned data.
     const size_t before = f->bytes();
@@ -185,7 +186,16 @@ TEST(HemiField, DefaultsAndMemory) {
     EXPECT_EQ(f->bytes(), before);
     EXPECT_GE(f->scratchBytes(), 1000u * 12u);
     f->endPass();
-    EXPECT_EQ(f->bytes(), before);
+    // The region that learned has tables of its own now: exactly one block more.
+    EXPECT_EQ(f->learnedRegions(), 1u);
+    EXPECT_EQ(f->bytes(), before + block);
+    // Every region learned: within the estimate that max-mb checks.
+    f->beginPass(1);
+    for (int r = 0; r < f->numRegions(); ++r) f->record(0, r, f->regionNormal(r), 1.f);
+    f->endPass();
+    EXPECT_EQ(f->learnedRegions(), size_t(f->numRegions()));
+    EXPECT_GE(f->bytes(), perRegion + size_t(f->numRegions()) * block);
+    EXPECT_LE(double(f->bytes()), 1.05 * hemiEstimatedBytes(f->params()));
 }
 
 TEST(HemiField, LookupOnPlaneSidesAndAngle) {

@@ -122,5 +122,57 @@ TEST(StrataTable, ManyVisitsKeepTheirOwnQ) {
     EXPECT_NEAR(est[0], 3.0, 3.0 * 1e-3);
 }
 
+// Lazy tables (one shared block until a region learns) hold the same data per region as
+// tables with a block per region, over passes that reach new regions, and after assign().
+TEST(StrataTable, LazyTablesMatchEagerOnesRegionByRegion) {
+    const int regions = 6, n = 16;
+    auto policy = [](int, const double* q, float* cdf) { buildStrataCdf(q, n, 0.1, cdf); };
+    StrataTable eager, lazy;
+    for (StrataTable* t : {&eager, &lazy}) t->setSmoothing(StrataLayout(4, 4).quadtree(), 2.0);
+    eager.reset(regions, n, 1e-3, policy);
+    lazy.reset(regions, n, 1e-3, policy, /*lazy=*/true);
+    EXPECT_EQ(eager.learnedRegions(), size_t(regions));
+    EXPECT_EQ(lazy.learnedRegions(), 0u);
+    EXPECT_LT(lazy.bytes(), eager.bytes());
+    auto same = [&](const StrataTable& a, const StrataTable& b, const char* when) {
+        for (size_t r = 0; r < size_t(regions); ++r) {
+            for (int j = 0; j < n; ++j) {
+                EXPECT_EQ(a.q(r)[j], b.q(r)[j]) << when << " region " << r;
+                EXPECT_EQ(a.visits(r)[j], b.visits(r)[j]) << when << " region " << r;
+                EXPECT_EQ(a.estimates(r)[j], b.estimates(r)[j]) << when << " region " << r;
+            }
+            for (int j = 0; j <= n; ++j) EXPECT_EQ(a.cdf(r)[j], b.cdf(r)[j]) << when << r;
+        }
+    };
+    same(eager, lazy, "untrained");
+    // Pass 1 reaches regions 4 and 1, pass 2 regions 1, 3 and 5 (blocks appended out of
+    // region order across passes).
+    const std::vector<std::vector<int>> passes = {{4, 1}, {1, 3, 5}};
+    for (size_t p = 0; p < passes.size(); ++p) {
+        for (StrataTable* t : {&eager, &lazy}) {
+            t->beginPass(2);
+            for (int r : passes[p])
+                for (int i = 0; i < 5; ++i)
+                    t->record(i % 2, r, float(r + i + p), [&] { return (r * 3 + i) % n; });
+            t->endPass(true, 1.0, policy);
+        }
+        same(eager, lazy, p == 0 ? "pass 1" : "pass 2");
+    }
+    EXPECT_EQ(lazy.learnedRegions(), 4u);  // 1, 3, 4, 5; 0 and 2 share the prior
+    // assign(): region-major data, as a saved field holds it.
+    std::vector<double> q;
+    std::vector<uint64_t> visits;
+    for (size_t r = 0; r < size_t(regions); ++r) {
+        q.insert(q.end(), eager.q(r), eager.q(r) + n);
+        visits.insert(visits.end(), eager.visits(r), eager.visits(r) + n);
+    }
+    StrataTable loaded;
+    loaded.setSmoothing(StrataLayout(4, 4).quadtree(), 2.0);
+    loaded.reset(regions, n, 1e-3, policy, /*lazy=*/true);
+    loaded.assign(q, visits, policy);
+    same(eager, loaded, "assigned");
+    EXPECT_EQ(loaded.learnedRegions(), 4u);
+}
+
 }  // namespace
 }  // namespace rlpbrt::guiding
