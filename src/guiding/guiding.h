@@ -46,7 +46,7 @@ struct GuidingStats {
     uint64_t rejectedTargets = 0;   // NaN, Inf or negative targets dropped by record()
     uint64_t rejectedRecords = 0;   // bad slot/region or direction outside the hemisphere
     uint64_t activeVoxels = 0;      // vdb backend: active voxels of the grid (0 otherwise)
-    uint64_t learnedRegions = 0;    // hemi backend: hemispheres with tables of their own
+    uint64_t learnedRegions = 0;    // regions with tables of their own (hemi, vdb surfaces)
     uint64_t selectionRegions = 0;  // regions with a learned selection (mix=learn)
     double selectionMean = 0.0;     // their mean selection probability
 };

@@ -327,13 +327,11 @@ bool HemiField::save(const std::string& path, std::string* error) const {
     w.u64(st.rejectedTargets);
     w.u64(st.rejectedRecords);
     w.u64(uint64_t(numRegions()));
-    // Region-major, every region (those still on the prior write its Q and visits).
-    const size_t regions = size_t(numRegions()), n = size_t(strata_);
-    w.data.reserve(w.data.size() + regions * n * 16);
-    for (size_t reg = 0; reg < regions; ++reg)
-        for (size_t j = 0; j < n; ++j) w.f64(table_.q(reg)[j]);
-    for (size_t reg = 0; reg < regions; ++reg)
-        for (size_t j = 0; j < n; ++j) w.u64(table_.visits(reg)[j]);
+    const std::vector<double> q = table_.denseQ();
+    const std::vector<uint64_t> visits = table_.denseVisits();
+    w.data.reserve(w.data.size() + q.size() * 16);
+    for (double d : q) w.f64(d);
+    for (uint64_t v : visits) w.u64(v);
     if (!fieldio::writeFile(path, w.data, error)) return false;
     return true;
 }

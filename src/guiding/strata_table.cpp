@@ -302,6 +302,20 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
     }
 }
 
+std::vector<double> StrataTable::denseQ() const {
+    std::vector<double> out;
+    out.reserve(regions_ * size_t(strata_));
+    for (size_t r = 0; r < regions_; ++r) out.insert(out.end(), q(r), q(r) + strata_);
+    return out;
+}
+
+std::vector<uint64_t> StrataTable::denseVisits() const {
+    std::vector<uint64_t> out;
+    out.reserve(regions_ * size_t(strata_));
+    for (size_t r = 0; r < regions_; ++r) out.insert(out.end(), visits(r), visits(r) + strata_);
+    return out;
+}
+
 size_t StrataTable::bytes() const {
     return q_.capacity() * sizeof(double) + est_.capacity() * sizeof(float) +
            visits_.capacity() * sizeof(uint64_t) + cdf_.capacity() * sizeof(float) +

@@ -111,6 +111,9 @@ public:
     SelectionLearner& selection() { return selection_; }
     const SelectionLearner& selection() const { return selection_; }
 
+    // Q and visits of every region, region-major (what saved fields hold).
+    std::vector<double> denseQ() const;
+    std::vector<uint64_t> denseVisits() const;
     // The raw tables, block-major (for bitwise comparisons of fields made alike).
     const std::vector<double>& qTable() const { return q_; }
     const std::vector<uint64_t>& visitTable() const { return visits_; }

@@ -188,7 +188,8 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
         table_.setSmoothing(params_.sphere ? layout_.sphereQuadtree() : layout_.quadtree(),
                             params_.smooth);
     table_.reset(clusterNormals_.size() * (params_.sphere ? 1 : 2),
-                 layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy());
+                 layout_.count() * (params_.sphere ? 2 : 1), params_.init, policy(),
+                 /*lazy=*/true);
     resetConfidence();
     if (params_.volume && scene.hasMedia()) {
         VolumeParams vp;
@@ -502,12 +503,13 @@ std::string VdbField::describe() const {
     char buf[800];
     std::snprintf(buf, sizeof(buf),
                   "vdb: %zu active voxels of %g (from %llu points, %llu draws), %zu normals, "
-                  "%d regions (%s), %dx%d strata, alpha=%s, init=%g, epsilon=%g, cosine=%d, %.1f MiB "
+                  "%d regions (%s; %zu with tables of their own), %dx%d strata, alpha=%s, init=%g, epsilon=%g, cosine=%d, %.1f MiB "
                   "(grid %.2f MiB; +%.1f MiB record buffers); passes=%llu, records=%llu, "
                   "rejected targets=%llu, rejected records=%llu%s",
                   activeVoxels(), voxelSize_, (unsigned long long)points_,
                   (unsigned long long)attempts_, clusterCount(), numRegions(),
                   params_.sphere ? "full sphere per voxel" : "two hemispheres per normal",
+                  table_.learnedRegions(),
                   params_.cols, params_.rows, alpha, params_.init, params_.epsilon,
                   int(params_.cosine && !params_.sphere), double(bytes()) / (1024.0 * 1024.0),
                   double(gridBytes()) / (1024.0 * 1024.0),
@@ -520,6 +522,7 @@ std::string VdbField::describe() const {
 GuidingStats VdbField::stats() const {
     GuidingStats s = table_.stats();
     s.activeVoxels = activeVoxels();
+    s.learnedRegions = table_.learnedRegions();
     if (volume_) {
         const GuidingStats& v = volume_->stats();
         s.records += v.records;
@@ -555,9 +558,9 @@ bool VdbField::save(const std::string& path, std::string* error) const {
         for (const glm::vec3& n : clusterNormals_) normals.vec3(n);
         copy->insertMeta("rlpbrt:clusters", openvdb::StringMetadata(counts.data));
         copy->insertMeta("rlpbrt:normals", openvdb::StringMetadata(normals.data));
-        copy->insertMeta("rlpbrt:q", openvdb::StringMetadata(fieldio::packDoubles(table_.qTable())));
+        copy->insertMeta("rlpbrt:q", openvdb::StringMetadata(fieldio::packDoubles(table_.denseQ())));
         copy->insertMeta("rlpbrt:visits",
-                         openvdb::StringMetadata(fieldio::packU64(table_.visitTable())));
+                         openvdb::StringMetadata(fieldio::packU64(table_.denseVisits())));
         const GuidingStats& s = table_.stats();
         copy->insertMeta("rlpbrt:passes", openvdb::Int64Metadata(int64_t(s.passes)));
         copy->insertMeta("rlpbrt:records", openvdb::Int64Metadata(int64_t(s.records)));
@@ -575,9 +578,9 @@ bool VdbField::save(const std::string& path, std::string* error) const {
                                                          params_.volumeCols, params_.volumeRows)));
             copy->insertMeta("rlpbrt:volume_cells", openvdb::StringMetadata(coords.data));
             copy->insertMeta("rlpbrt:volume_q",
-                             openvdb::StringMetadata(fieldio::packDoubles(volume_->table().qTable())));
+                             openvdb::StringMetadata(fieldio::packDoubles(volume_->table().denseQ())));
             copy->insertMeta("rlpbrt:volume_visits",
-                             openvdb::StringMetadata(fieldio::packU64(volume_->table().visitTable())));
+                             openvdb::StringMetadata(fieldio::packU64(volume_->table().denseVisits())));
             copy->insertMeta("rlpbrt:volume_counters", openvdb::StringMetadata(counters.data));
         }
         const std::string tmp = path + ".tmp";
@@ -768,7 +771,7 @@ bool VdbField::load(const std::string& path, std::string* error) {
         clusterStart_ = std::move(starts);
         clusterNormals_ = std::move(normals);
         buildFrames();
-        table_.reset(regions, int(strata), params_.init, policy());
+        table_.reset(regions, int(strata), params_.init, policy(), /*lazy=*/true);
         resetConfidence();
         table_.assign(std::move(q), std::move(visits), policy());
         table_.stats() = s;

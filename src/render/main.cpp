@@ -289,7 +289,7 @@ int main(int argc, char** argv) {
             j["guide_rejected_targets"] = gs.rejectedTargets;
             j["guide_mix"] = mix;
             if (guide == "vdb") j["guide_active_voxels"] = gs.activeVoxels;
-            if (guide == "hemi") j["guide_learned_regions"] = gs.learnedRegions;
+            j["guide_learned_regions"] = gs.learnedRegions;
             if (gs.mediumCells) j["guide_medium_cells"] = gs.mediumCells;
             if (gs.selectionRegions) {
                 j["guide_selection_regions"] = gs.selectionRegions;
