@@ -50,8 +50,15 @@ void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy)
     regions_ = regions;
     selection_.grow(regions);
     if (lazy_) {
-        if (blocks_ == 0) return;  // (reset with no regions: no prior block to share)
         block_.resize(regions, 0);
+        if (blocks_ == 0) {  // the first regions: build the prior block they share
+            blocks_ = 1;
+            q_.assign(n, init_);
+            est_.assign(n, float(std::min(init_, double(FLT_MAX))));
+            visits_.assign(n, 0);
+            cdf_.assign(n + 1, 0.f);
+            rebuild(0, policy);
+        }
         return;
     }
     block_.resize(regions);

@@ -172,6 +172,14 @@ TEST(StrataTable, LazyTablesMatchEagerOnesRegionByRegion) {
     loaded.assign(q, visits, policy);
     same(eager, loaded, "assigned");
     EXPECT_EQ(loaded.learnedRegions(), 4u);
+    // Grown from no regions, a lazy table shares an untrained block like the rest.
+    StrataTable grown;
+    grown.setSmoothing(StrataLayout(4, 4).quadtree(), 2.0);
+    grown.reset(0, n, 1e-3, policy, /*lazy=*/true);
+    grown.grow(3, 1e-3, policy);
+    EXPECT_EQ(grown.learnedRegions(), 0u);
+    for (size_t r = 0; r < 3; ++r)
+        for (int j = 0; j <= n; ++j) EXPECT_EQ(grown.cdf(r)[j], eager.cdf(0)[j]) << r;
 }
 
 }  // namespace
