@@ -23,14 +23,7 @@ void StrataTable::reset(size_t regions, int strata, double init, const PolicyBui
     blocks_ = lazy ? (regions > 0 ? 1 : 0) : regions;
     block_.resize(regions);
     for (size_t r = 0; r < regions; ++r) block_[r] = lazy ? 0 : uint32_t(r);
-    q_.assign(blocks_ * n, init);
-    est_.assign(blocks_ * n, float(std::min(init, double(FLT_MAX))));
-    visits_.assign(blocks_ * n, 0);
-    cdf_.assign(blocks_ * (n + 1), 0.f);
-    q_.shrink_to_fit();
-    est_.shrink_to_fit();
-    visits_.shrink_to_fit();
-    cdf_.shrink_to_fit();
+    untrainedBlocks(blocks_);
     // Every region starts with the same Q and no visits: build the first one and copy it.
     if (regions > 0) {
         rebuild(0, policy);
@@ -44,6 +37,18 @@ void StrataTable::reset(size_t regions, int strata, double init, const PolicyBui
     selection_.reset(regions);
 }
 
+void StrataTable::untrainedBlocks(size_t blocks) {
+    const size_t n = size_t(strata_);
+    q_.assign(blocks * n, init_);
+    est_.assign(blocks * n, float(std::min(init_, double(FLT_MAX))));
+    visits_.assign(blocks * n, 0);
+    cdf_.assign(blocks * (n + 1), 0.f);
+    q_.shrink_to_fit();
+    est_.shrink_to_fit();
+    visits_.shrink_to_fit();
+    cdf_.shrink_to_fit();
+}
+
 void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy) {
     if (regions <= regions_ || strata_ <= 0) return;
     const size_t n = size_t(strata_), old = regions_;
@@ -53,10 +58,7 @@ void StrataTable::grow(size_t regions, double init, const PolicyBuilder& policy)
         block_.resize(regions, 0);
         if (blocks_ == 0) {  // the first regions: build the prior block they share
             blocks_ = 1;
-            q_.assign(n, init_);
-            est_.assign(n, float(std::min(init_, double(FLT_MAX))));
-            visits_.assign(n, 0);
-            cdf_.assign(n + 1, 0.f);
+            untrainedBlocks(1);
             rebuild(0, policy);
         }
         return;

@@ -139,6 +139,9 @@ private:
     void applyRegion(size_t region, const Record* begin, const Record* end, bool alphaVisits,
                      double fixedAlpha, double* sums, uint64_t* counts, double* scratch,
                      const PolicyBuilder& policy);
+    // Sets the tables to `blocks` blocks of Q = init and no visits (estimates init, CDFs
+    // zero until rebuilt), with exact capacities.
+    void untrainedBlocks(size_t blocks);
     // Appends a block per region (Q and visits copied from q[i] / visits[i], or from the prior
     // where null; estimates and CDF the prior's until rebuilt). Not during a pass.
     void addBlocks(const std::vector<size_t>& regions, const std::vector<const double*>& q,
