@@ -24,13 +24,6 @@ bool BSDF::add(const BxDF& bxdf) {
     return true;
 }
 
-int BSDF::numComponents(BxDFFlags flags) const {
-    int count = 0;
-    for (int i = 0; i < n_; ++i)
-        if (matchesFlags(flags_[i], flags)) ++count;
-    return count;
-}
-
 bool BSDF::isDelta() const {
     if (n_ == 0) return false;
     for (int i = 0; i < n_; ++i)

@@ -49,7 +49,12 @@ class BSDF {
     const BxDF& component(int i) const { return bxdfs_[i]; }
 
     // Number of lobes whose flags are contained in `flags`.
-    int numComponents(BxDFFlags flags = BxDFFlags::All) const;
+    // (Inline: the integrator asks several times per vertex.)
+    int numComponents(BxDFFlags flags = BxDFFlags::All) const {
+        int count = 0;
+        for (int i = 0; i < n_; ++i) count += matchesFlags(flags_[i], flags) ? 1 : 0;
+        return count;
+    }
     // True if there is at least one lobe and all lobes are specular (delta distributions).
     bool isDelta() const;
     // Union of the flags of all lobes.

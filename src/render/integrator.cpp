@@ -137,21 +137,19 @@ Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w, float smallScale) 
 // The share of a guidable BSDF's lobes that are diffuse: the guide's table (Q cos, no BSDF
 // product) suits diffuse lobes; a glossy lobe is narrower than a stratum and is better
 // sampled by the BSDF. The integrator scales its guide probability by this share.
-float diffuseShare(const BSDF& bsdf) {
-    const int all = bsdf.numComponents();
+// `all` is bsdf.numComponents().
+float diffuseShare(const BSDF& bsdf, int all) {
     return all > 0 ? float(bsdf.numComponents(BxDFFlags::Reflection | BxDFFlags::Transmission |
                                               BxDFFlags::Diffuse)) /
                          float(all)
                    : 0.f;
 }
 
-// A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide).
+// A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide). `all` is
+// bsdf.numComponents(), `smooth` bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular)
 // (numComponents counts lobes whose flags are all among the requested ones, so "specular
-// lobes" are the lobes not counted without the Specular bit.)
-bool guidable(const BSDF& bsdf) {
-    int all = bsdf.numComponents();
-    return all > 0 && bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) == all;
-}
+// lobes" are the lobes not counted without the Specular bit).
+bool guidable(int all, int smooth) { return all > 0 && smooth == all; }
 
 // A guided vertex of the path whose direction sample feeds the selection learning (mix=learn):
 // the radiance the path gathers after it, over the throughput at it, is the sample's
@@ -548,7 +546,10 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (bounces >= maxDepth_ && !pending.active()) break;
         bsdf.clear();
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
-        const bool canGuide = field && guidable(bsdf);
+        // Lobe counts, asked once: all lobes and the non-specular ones.
+        const int lobes = bsdf.numComponents();
+        const int smoothLobes = bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular);
+        const bool canGuide = field && guidable(lobes, smoothLobes);
         int region = -1;
         if (canGuide && wantsRegion) {
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
@@ -557,13 +558,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const bool lastVertex = bounces >= maxDepth_;
         // The guide's probability here: mix x the region's confidence x the diffuse share.
         const float share =
-            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(bsdf) : 0.f;
+            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(bsdf, lobes) : 0.f;
         const int sampleRegion = share > 0.f ? region : -1;
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
         if (!lastVertex) {
             ++stats.vertices;
-            if (bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular) > 0)
+            if (smoothLobes > 0)
                 L += beta * sampleLight(si, bsdf, sampleRegion, share, sampler, stats,
                                         media ? &pm : nullptr);
         }
@@ -576,7 +577,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 deferTarget = true;  // completed below with the direction sampled at y
             else if (region >= 0)
                 flush(emitted + std::max(scattered, 0.f));
-            else if (canGuide || bsdf.numComponents() == 0)
+            else if (canGuide || lobes == 0)
                 pending = PendingRecord();  // no data at y: nothing to learn from
             else
                 pending.target += pending.weight * emitted;  // delta y: continue the chain
