@@ -41,15 +41,10 @@ public:
 
     // Starts loading the first entry p's cell probes (p finite).
     void prefetch(const glm::vec3& p) const {
-        glm::vec3 c;
-        __builtin_prefetch(&entries_[size_t(mix(keyOf(p, &c) + 1)) & mask_]);
+        __builtin_prefetch(&entries_[size_t(mix(keyOf(p) + 1)) & mask_]);
     }
     // The centre of p's cell (where the candidates of p were computed).
-    glm::vec3 centreOf(const glm::vec3& p) const {
-        glm::vec3 c;
-        keyOf(p, &c);
-        return c;
-    }
+    glm::vec3 centreOf(const glm::vec3& p) const { return centreOfKey(keyOf(p)); }
     float cellSize() const { return cell_; }
     size_t capacity() const { return mask_ + 1; }
     // Entries filled so far.
@@ -58,7 +53,16 @@ public:
 
 private:
     static constexpr uint32_t kUnset = UINT32_MAX;
-    uint64_t keyOf(const glm::vec3& p, glm::vec3* centre) const;  // (inline below)
+    // The key of p's cell (its three cell coordinates), and the centre of a key's cell (only
+    // when a list is computed: the lookups themselves need just the key).
+    uint64_t keyOf(const glm::vec3& p) const;  // (inline below)
+    glm::vec3 centreOfKey(uint64_t key) const {
+        constexpr uint64_t axisMask = (uint64_t(1) << kAxisBits) - 1;
+        glm::vec3 centre;
+        for (int a = 0; a < 3; ++a)
+            centre[a] = origin_[a] + (float((key >> (a * kAxisBits)) & axisMask) + 0.5f) * cell_;
+        return centre;
+    }
     // A 64-bit finaliser (every key bit reaches the low bits the table indexes with).
     static uint64_t mix(uint64_t x) {
         x ^= x >> 30;
@@ -82,7 +86,7 @@ private:
     mutable std::atomic<size_t> used_{0};
 };
 
-inline uint64_t CellCache::keyOf(const glm::vec3& p, glm::vec3* centre) const {
+inline uint64_t CellCache::keyOf(const glm::vec3& p) const {
     constexpr int64_t maxCell = (int64_t(1) << kAxisBits) - 1;
     uint64_t key = 0;
     for (int a = 0; a < 3; ++a) {
@@ -90,7 +94,6 @@ inline uint64_t CellCache::keyOf(const glm::vec3& p, glm::vec3* centre) const {
         // baseline x86-64 target has no inline floor).
         const float f = (p[a] - origin_[a]) * invCell_;
         const int64_t c = f <= 0.f ? 0 : f >= float(maxCell) ? maxCell : int64_t(f);
-        (*centre)[a] = origin_[a] + (float(c) + 0.5f) * cell_;
         key |= uint64_t(c) << (a * kAxisBits);
     }
     return key;
@@ -99,8 +102,7 @@ inline uint64_t CellCache::keyOf(const glm::vec3& p, glm::vec3* centre) const {
 template <class Fill>
 int CellCache::candidates(const glm::vec3& p, Fill&& fill, uint32_t* scratch,
                           const uint32_t** out) const {
-    glm::vec3 centre;
-    const uint64_t key = keyOf(p, &centre) + 1;
+    const uint64_t cell = keyOf(p), key = cell + 1;
     size_t slot = size_t(mix(key)) & mask_;
     for (int probe = 0; probe < kMaxProbes; ++probe, slot = (slot + 1) & mask_) {
         Entry& e = entries_[slot];
@@ -119,13 +121,13 @@ int CellCache::candidates(const glm::vec3& p, Fill&& fill, uint32_t* scratch,
             continue;                    // claimed for another cell: probe on
         }
         used_.fetch_add(1, std::memory_order_relaxed);
-        const int n = fill(centre, e.list);
+        const int n = fill(centreOfKey(cell), e.list);
         e.count.store(uint32_t(n), std::memory_order_release);
         *out = e.list;
         return n;
     }
     *out = scratch;
-    return fill(centre, scratch);
+    return fill(centreOfKey(cell), scratch);
 }
 
 }  // namespace rlpbrt::guiding
