@@ -18,11 +18,7 @@ bool finite3(const glm::vec3& v) {
 }  // namespace
 
 double hemiEstimatedBytes(const HemiParams& p) {
-    const double n = double(p.cols) * double(p.rows);
-    const double perRegion =
-        n * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) + (n + 1) * sizeof(float) +
-        64.0 +  // RegionFrame
-        SelectionLearner::kBytesPerRegion;
+    const double perRegion = StrataTable::regionBytes(p.cols * p.rows) + 64.0;  // + RegionFrame
     // Per point: position, normal, the tree's copy, its index entry and a share of the nodes,
     // and up to 16 entries of the lookup's cell memo (8, rounded up to a power of two).
     const double perPoint = 3 * sizeof(glm::vec3) + sizeof(uint32_t) + 8.0 +

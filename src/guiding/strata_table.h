@@ -36,6 +36,13 @@ public:
 
     size_t regions() const { return regions_; }
     int strata() const { return strata_; }
+    // Bytes of one region's block of tables with `strata` strata (Q, estimates, visits, CDF)
+    // and its learned selection: the per-region term of the backends' memory estimates.
+    static double regionBytes(int strata) {
+        const double n = strata;
+        return n * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) +
+               (n + 1) * sizeof(float) + SelectionLearner::kBytesPerRegion;
+    }
     const double* q(size_t region) const { return &q_[block_[region] * size_t(strata_)]; }
     // The estimates of a region's strata that queries and the policy use, frozen per pass:
     // Q itself, or with smoothing the shrunken estimates below.

@@ -72,19 +72,16 @@ double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
     const double voxels = std::min(points, std::isfinite(crossed) ? crossed : points);
     // Most voxels hold one surface orientation; edges and corners hold more (counted as 2).
     const double regionsPerVoxel = params.sphere ? 1.0 : 2.0 * std::min(params.normals, 2);
-    const double s = double(params.cols) * params.rows * (params.sphere ? 2.0 : 1.0);
-    const double perRegion = s * (sizeof(double) + sizeof(float) + sizeof(uint64_t)) +
-                             (s + 1) * sizeof(float) + sizeof(HemiFrame) +
-                             SelectionLearner::kBytesPerRegion;
+    const double perRegion =
+        StrataTable::regionBytes(params.cols * params.rows * (params.sphere ? 2 : 1)) +
+        sizeof(HemiFrame);
     // Per voxel: normals, offsets and about 8 bytes of OpenVDB tree (leaf values and masks).
     return voxels * (regionsPerVoxel * (perRegion + sizeof(int)) + 2 * sizeof(glm::vec3) + 12.0);
 }
 
 double vdbMediumCellBytes(const VdbParams& params) {
-    // Per stratum Q (double), float Q, visits and the CDF entry; per cell ~64 bytes more.
-    return 2.0 * params.volumeCols * params.volumeRows *
-               (sizeof(double) + 2 * sizeof(float) + sizeof(uint64_t)) +
-           64.0 + SelectionLearner::kBytesPerRegion;
+    // A full-sphere table per cell, and ~64 bytes of grid and index.
+    return StrataTable::regionBytes(2 * params.volumeCols * params.volumeRows) + 64.0;
 }
 
 VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
