@@ -143,7 +143,7 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
         *maxMiB = d;
     } else if (key == "mix" || key == "target" || key == "samples" || key == "auto" ||
-               key == "rr" || key == "rr-window") {
+               key == "rr" || key == "rr-window" || key == "learn") {
         // Consumed by the integrator and the render loop.
     } else {
         return 0;
@@ -176,7 +176,7 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
                      "cosine, warmup, lookup, smooth, max-mb, mix, target, samples, auto, rr, "
-                     "rr-window)";
+                     "rr-window, learn)";
             return false;
         }
     }
@@ -235,7 +235,7 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
                      "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
                      "normal-angle, init, epsilon, cosine, warmup, smooth, volume, "
                      "volume-voxel, volume-strata, volume-warmup, max-mb, mix, target, "
-                     "samples, auto, rr, rr-window)";
+                     "samples, auto, rr, rr-window, learn)";
             return false;
         }
     }

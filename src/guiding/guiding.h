@@ -183,12 +183,13 @@ public:
 //                estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
 //   max-mb       refuse configurations whose tables would exceed this many MiB
 //                (default 4096)
-//   mix, target, samples, auto, rr, rr-window
+//   mix, target, samples, auto, rr, rr-window, learn
 //                consumed by the integrator and the render loop; accepted and ignored here
 //                ("target=path|sample|sum": train on the path's returns, the default, or
 //                on Eq. 1's bootstrap; "samples=independent": a sample set per pass;
 //                "auto=N": the guided-or-plain trial; "rr=adjoint|pbrt" and "rr-window=w":
-//                the integrator's roulette; "mix=learn" makes the integrator
+//                the integrator's roulette; "learn=N": learning in the first N spp only;
+//                "mix=learn" makes the integrator
 //                record selection samples, from which every backend learns selection() per
 //                region)
 // Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.

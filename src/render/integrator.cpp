@@ -100,6 +100,17 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
         }
         settings->rouletteWindow = w;
     }
+    auto learn = config.params.find("learn");
+    if (learn != config.params.end() && learn->second != "all") {
+        char* end = nullptr;
+        const long n = std::strtol(learn->second.c_str(), &end, 10);
+        if (end == learn->second.c_str() || *end != '\0' || n < 0 || n > (1L << 24)) {
+            *error = "learn must be \"all\" or a sample count in [0, 16777216], got \"" +
+                     learn->second + "\"";
+            return false;
+        }
+        settings->learnSpp = int(n);
+    }
     auto autoSpp = config.params.find("auto");
     if (autoSpp != config.params.end()) {
         char* end = nullptr;

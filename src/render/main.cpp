@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
                    "guiding parameter key=value (repeatable): mix (0..1 or learn), alpha, "
                    "strata (WxH), points, normal-angle, init, epsilon, cosine, smooth, max-mb, "
                    "target (path, sample or sum), rr (adjoint or pbrt), rr-window, samples, auto (N "
-                   "spp: a guided-or-plain trial; default off); hemi: knn, warmup, lookup "
+                   "spp: a guided-or-plain trial; default off), learn (N spp or all); hemi: knn, warmup, lookup "
                    "(cell or exact); vdb: "
                    "voxel, voxel-size, dirs, normals, warmup, volume, volume-voxel "
                    "(README.md)");
@@ -175,6 +175,9 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "guide: %s (%.2f s to build)\n", field->describe().c_str(),
                          seconds() - tg);
     }
+    if (field && guideSettings.learnSpp == 0 && guideLoad.empty())
+        std::fprintf(stderr, "warning: learn=0 without --guide-load: the guide never learns, "
+                             "so every vertex samples its BSDF (at the guide's cost)\n");
     const float mix = guideSettings.mix;
 
     if (outFile.empty()) outFile = defaultOutput(*scene);
@@ -298,6 +301,7 @@ int main(int argc, char** argv) {
             const RenderResult::AutoTrial& at = r.autoTrial;
             j["guide_auto"] = !at.ran ? "not run" : at.keptGuiding ? "kept" : "off";
             j["guide_guided_spp"] = at.guidedSpp;
+            j["guide_learning_spp"] = r.learningSpp;
             if (at.ran) {
                 j["guide_auto_guided_cost"] = at.guidedCost;
                 j["guide_auto_plain_cost"] = at.plainCost;

@@ -131,6 +131,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         trial == Trial::Pending ? std::make_unique<PassMoments>(film.sampleBounds()) : nullptr;
     double guidedSecondsPerSample = 0.0;
     int guidedCount = 0;
+    // learn=N (GuideSettings::learnSpp): guided passes learn until N samples per pixel, then
+    // sample from the guide as it is with an integrator that records nothing.
+    const int learnSpp = options.guide.learnSpp;
+    std::unique_ptr<PathIntegrator> frozenIntegrator;
 
     tbb::enumerable_thread_specific<std::unique_ptr<Sampler>> samplers(
         [&] { return scene.sampler->clone(); });
@@ -164,6 +168,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
         }
         if (count <= 0) break;
+        // A learning pass ends where learning does.
+        const bool learning = guided && (learnSpp < 0 || result.spp < learnSpp);
+        if (learning && learnSpp >= 0) count = std::min(count, learnSpp - result.spp);
         // The trial starts at autoSpp, or a quarter into a time budget if that comes first.
         if (trial == Trial::Pending && count >= 2 &&
             (result.spp + count >= options.guide.autoSpp ||
@@ -182,9 +189,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             }
         }
         const bool guidedPass = guided && trial != Trial::MeasurePlain;
+        const bool learningPass = guidedPass && learning;
+        if (guidedPass && !learningPass && !frozenIntegrator) {
+            GuideSettings frozen = options.guide;
+            frozen.learn = false;
+            frozenIntegrator = std::make_unique<PathIntegrator>(scene, frozen);
+            result.learningSpp = result.spp;
+        }
         // (Without a field, `integrator` is plain already.)
-        const PathIntegrator& passIntegrator =
-            guidedPass || !plainIntegrator ? integrator : *plainIntegrator;
+        const PathIntegrator& passIntegrator = learningPass                   ? integrator
+                                               : guidedPass                   ? *frozenIntegrator
+                                               : plainIntegrator              ? *plainIntegrator
+                                                                              : integrator;
         PassMoments* moments = trial == Trial::MeasureGuided  ? guidedMoments.get()
                                : trial == Trial::MeasurePlain ? plainMoments.get()
                                                               : nullptr;
@@ -195,7 +211,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         const int first = ownSet ? 0 : result.spp;
         std::unique_ptr<Sampler> passProto =
             ownSet ? scene.sampler->passSampler(count, pass) : nullptr;
-        if (guidedPass) field->beginPass(int(tiles.size()));
+        if (learningPass) field->beginPass(int(tiles.size()));
         arena.execute([&] {
             tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
                 std::unique_ptr<Sampler> passSampler = passProto ? passProto->clone() : nullptr;
@@ -236,7 +252,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             });
         });
         // The guide learns between passes: every pass samples from a frozen policy.
-        if (guidedPass) field->endPass();
+        if (learningPass) field->endPass();
         const double secondsPerSample =
             (cpuNow() - passStart) / (double(pixelsPerPass) * double(count));
         if (trial == Trial::MeasureGuided) {
@@ -282,6 +298,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         }
     }
     if (result.autoTrial.keptGuiding) result.autoTrial.guidedSpp = field ? result.spp : 0;
+    if (!frozenIntegrator) result.learningSpp = result.autoTrial.guidedSpp;
     if (options.progress) std::fprintf(stderr, "\n");
     result.seconds = now() - start;
     for (const auto& s : stats) result.stats.add(s);

@@ -139,11 +139,16 @@ TEST(GuideCrossValidation, IntegratorParametersAreValidated) {
     EXPECT_FLOAT_EQ(gs.rouletteWindow, 0.1f);  // the default
     ASSERT_TRUE(setup({{"rr-window", "0.25"}}, &gs, &err)) << err;
     EXPECT_FLOAT_EQ(gs.rouletteWindow, 0.25f);
+    EXPECT_EQ(gs.learnSpp, -1);  // the default: learn in every pass
+    ASSERT_TRUE(setup({{"learn", "16"}}, &gs, &err)) << err;
+    EXPECT_EQ(gs.learnSpp, 16);
+    ASSERT_TRUE(setup({{"learn", "all"}}, &gs, &err)) << err;
+    EXPECT_EQ(gs.learnSpp, -1);
     for (const auto& bad : std::vector<std::map<std::string, std::string>>{
              {{"mix", "learnt"}}, {{"mix", "1.5"}}, {{"samples", "random"}},
              {{"target", "all"}}, {{"auto", "-1"}}, {{"auto", "16x"}}, {{"auto", ""}},
              {{"rr", "russian"}}, {{"rr-window", "0"}}, {{"rr-window", "1.5"}},
-             {{"rr-window", "wide"}}}) {
+             {{"rr-window", "wide"}}, {{"learn", "-2"}}, {{"learn", "some"}}}) {
         err.clear();
         EXPECT_FALSE(setup(bad, &gs, &err)) << bad.begin()->first;
         EXPECT_NE(err.find(bad.begin()->first), std::string::npos) << err;

@@ -139,4 +139,57 @@ TEST(GuideFileCli, TheTrialRunsWhenAsked) {
     rmdir(dir.c_str());
 }
 
+// learn=N: the guide learns in the first N spp only (a render of N spp saves the same field
+// as one of more spp with learn=N), learn=0 renders with a loaded field and leaves it as it
+// was, --stats reports the learning spp, and bad values are errors.
+TEST(GuideFileCli, LearningStopsAtTheLearnBudget) {
+    char tmpl[] = "/tmp/rlpbrt-guidelearn-XXXXXX";
+    const std::string dir = mkdtemp(tmpl) ? tmpl : "/tmp";
+    const std::string scene = writeScene(dir + "/a.pbrt", false);
+    const std::string stats = dir + "/s.json";
+    const std::string a = scene + " --nthreads 1 --quiet --seed 4 -o " + dir +
+                          "/out.exr --stats " + stats + " --guide=hemi ";
+    const std::string f4 = dir + "/f4.hemi", f12 = dir + "/f12.hemi", f0 = dir + "/f0.hemi";
+    CliRun four = run(a + "--spp 4 --guide-save " + f4);
+    ASSERT_EQ(four.status, 0) << four.output;
+    std::string json = slurp(stats);
+    EXPECT_NE(json.find("\"guide_learning_spp\": 4,"), std::string::npos) << json;
+    CliRun twelve = run(a + "--spp 12 --guide-param learn=4 --guide-save " + f12);
+    ASSERT_EQ(twelve.status, 0) << twelve.output;
+    json = slurp(stats);
+    EXPECT_NE(json.find("\"guide_learning_spp\": 4,"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"guide_guided_spp\": 12,"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"spp\": 12,"), std::string::npos) << json;
+    const std::string saved4 = slurp(f4);
+    EXPECT_GT(saved4.size(), 1000u);
+    EXPECT_EQ(saved4, slurp(f12));
+    // Learning everything (the default) changes the field after 4 spp.
+    CliRun all = run(a + "--spp 12 --guide-param learn=all --guide-save " + f0);
+    ASSERT_EQ(all.status, 0) << all.output;
+    EXPECT_NE(saved4, slurp(f0));
+    json = slurp(stats);
+    EXPECT_NE(json.find("\"guide_learning_spp\": 12,"), std::string::npos) << json;
+
+    CliRun frozen = run(a + "--spp 6 --guide-param learn=0 --guide-load " + f4 +
+                        " --guide-save " + f0);
+    ASSERT_EQ(frozen.status, 0) << frozen.output;
+    EXPECT_EQ(frozen.output.find("warning"), std::string::npos) << frozen.output;
+    EXPECT_EQ(saved4, slurp(f0));
+    json = slurp(stats);
+    EXPECT_NE(json.find("\"guide_learning_spp\": 0,"), std::string::npos) << json;
+
+    CliRun untrained = run(a + "--spp 1 --guide-param learn=0");
+    EXPECT_EQ(untrained.status, 0) << untrained.output;
+    EXPECT_NE(untrained.output.find("warning: learn=0 without --guide-load"), std::string::npos)
+        << untrained.output;
+    for (const char* bad : {"-1", "x", "1.5", "", "16777217"}) {
+        CliRun r = run(a + "--spp 1 --guide-param learn=" + std::string(bad));
+        EXPECT_EQ(r.status, 1) << bad << r.output;
+        EXPECT_NE(r.output.find("learn must be"), std::string::npos) << bad << r.output;
+    }
+    for (const char* f : {"a.pbrt", "out.exr", "s.json", "f4.hemi", "f12.hemi", "f0.hemi"})
+        std::remove((dir + "/" + f).c_str());
+    rmdir(dir.c_str());
+}
+
 }  // namespace

@@ -5,6 +5,7 @@
 // Bounds (issue "path tracer" acceptance): relMSE <= 1.5x pbrt-v3's own 64-spp relMSE;
 // median block deviation <= max(2%, 1.5x pbrt-v3's own 64-spp figure); no NaN/Inf.
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "parser/diagnostics.h"
@@ -65,7 +66,8 @@ class ReferenceTest
     : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
 class MediaReferenceTest : public ReferenceTest {};
 
-void checkAgainstPbrtV3(const std::string& id, const char* guide, bool media) {
+void checkAgainstPbrtV3(const std::string& id, const char* guide, bool media,
+                        const std::map<std::string, std::string>& params = {}) {
     std::vector<ManifestRow> rows = readManifest();
     const ManifestRow* row = nullptr;
     for (const auto& r : rows)
@@ -84,6 +86,7 @@ void checkAgainstPbrtV3(const std::string& id, const char* guide, bool media) {
     ASSERT_NE(scene, nullptr);
     guiding::GuideConfig gc;
     gc.backend = guide;
+    gc.params = params;
     std::unique_ptr<guiding::GuidingField> field;
     RenderOptions ro;
     std::string gerr;
@@ -122,6 +125,16 @@ TEST_P(ReferenceTest, MatchesPbrtV3At64spp) {
 TEST_P(MediaReferenceTest, MatchesPbrtV3At64spp) {
     RLPBRT_REQUIRE_SHARED();
     checkAgainstPbrtV3(std::get<0>(GetParam()), std::get<1>(GetParam()), true);
+}
+
+// learn=16: the passes after 16 spp sample from the guide as it was then and do not learn; the
+// image meets the same bounds (an easy scene, and one lit only indirectly).
+TEST(ReferenceLearnBudget, FrozenGuideMatchesPbrtV3At64spp) {
+    RLPBRT_REQUIRE_SHARED();
+    for (const char* id : {"cornell-box__scene", "veach-bidir__bidir"}) {
+        SCOPED_TRACE(id);
+        checkAgainstPbrtV3(id, "hemi", false, {{"learn", "16"}});
+    }
 }
 
 std::string sceneTestName(const ::testing::TestParamInfo<std::tuple<const char*, const char*>>& info) {
