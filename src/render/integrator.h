@@ -44,10 +44,11 @@ struct GuideSettings {
     // passes after them sample from the guide as it is then, without recording targets or
     // updating it between passes (no learning work; the image stays consistent, as with any
     // fixed guide). -1 (learn=all, the default): learn in every pass, as the paper does.
-    // learn=0 with --guide-load renders with a guide trained before. Measured at 64 spp, seed
-    // 2 (relMSE, seconds, one pass each): veach-bidir 0.0728 / 4.87 s (all) -> 0.0762 / 4.34 s
-    // (learn=16), cornell-box 0.000647 / 4.05 s -> 0.000692 / 3.73 s: the learning's share
-    // of the time, traded against the guide's further improvement.
+    // learn=0 with --guide-load renders with a guide trained before. Not the default: at 64
+    // spp, learn=16 saves 2-6% of the time (pinned pairs: cornell-box 0.938, veach-bidir
+    // 0.978, killeroo 0.976) and loses more per sample (relMSE, seeds 2/3: cornell-box
+    // 0.000653/0.000659 -> 0.000718/0.000722, veach-bidir 0.143/0.141 -> 0.167/0.181,
+    // breakfast 4.48/4.66 -> 4.57/5.10, killeroo equal; docs/BENCHMARKS.md).
     int learnSpp = -1;
     // With Eq. 1's targets (target=sum|sample, pathTarget false): how the sum of Eq. 1 is
     // evaluated at a non-Lambertian vertex y: over all strata

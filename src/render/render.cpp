@@ -197,10 +197,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             result.learningSpp = result.spp;
         }
         // (Without a field, `integrator` is plain already.)
-        const PathIntegrator& passIntegrator = learningPass                   ? integrator
-                                               : guidedPass                   ? *frozenIntegrator
-                                               : plainIntegrator              ? *plainIntegrator
-                                                                              : integrator;
+        const PathIntegrator& passIntegrator = learningPass      ? integrator
+                                               : guidedPass      ? *frozenIntegrator
+                                               : plainIntegrator ? *plainIntegrator
+                                                                 : integrator;
         PassMoments* moments = trial == Trial::MeasureGuided  ? guidedMoments.get()
                                : trial == Trial::MeasurePlain ? plainMoments.get()
                                                               : nullptr;
