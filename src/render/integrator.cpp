@@ -46,6 +46,14 @@ bool parseFloat(const std::string& text, float* out) {
     *out = std::strtof(text.c_str(), &end);
     return end != text.c_str() && *end == '\0';
 }
+// A whole-string sample count in [0, 2^24] (strtol syntax); false if the text is anything else.
+bool parseSampleCount(const std::string& text, int* out) {
+    char* end = nullptr;
+    const long n = std::strtol(text.c_str(), &end, 10);
+    if (end == text.c_str() || *end != '\0' || n < 0 || n > (1L << 24)) return false;
+    *out = int(n);
+    return true;
+}
 }  // namespace
 
 bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
@@ -101,26 +109,17 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
         settings->rouletteWindow = w;
     }
     auto learn = config.params.find("learn");
-    if (learn != config.params.end() && learn->second != "all") {
-        char* end = nullptr;
-        const long n = std::strtol(learn->second.c_str(), &end, 10);
-        if (end == learn->second.c_str() || *end != '\0' || n < 0 || n > (1L << 24)) {
-            *error = "learn must be \"all\" or a sample count in [0, 16777216], got \"" +
-                     learn->second + "\"";
-            return false;
-        }
-        settings->learnSpp = int(n);
+    if (learn != config.params.end() && learn->second != "all" &&
+        !parseSampleCount(learn->second, &settings->learnSpp)) {
+        *error = "learn must be \"all\" or a sample count in [0, 16777216], got \"" +
+                 learn->second + "\"";
+        return false;
     }
     auto autoSpp = config.params.find("auto");
-    if (autoSpp != config.params.end()) {
-        char* end = nullptr;
-        const long n = std::strtol(autoSpp->second.c_str(), &end, 10);
-        if (end == autoSpp->second.c_str() || *end != '\0' || n < 0 || n > (1L << 24)) {
-            *error = "auto must be a sample count in [0, 16777216] (0 = always guide), got \"" +
-                     autoSpp->second + "\"";
-            return false;
-        }
-        settings->autoSpp = int(n);
+    if (autoSpp != config.params.end() && !parseSampleCount(autoSpp->second, &settings->autoSpp)) {
+        *error = "auto must be a sample count in [0, 16777216] (0 = always guide), got \"" +
+                 autoSpp->second + "\"";
+        return false;
     }
     if (config.backend == "none") return true;
     guiding::SceneInfo info;
