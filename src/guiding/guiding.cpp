@@ -19,6 +19,10 @@ float GuidingField::confidence(int region) const { return region >= 0 ? 1.f : 0.
 
 float GuidingField::selection(int) const { return -1.f; }
 
+float GuidingField::policyRadiance(int region, const glm::vec3& w, int bin) const {
+    return radiance(region, w, bin);
+}
+
 void GuidingField::recordSelection(int, int, const SelectionSample&) {}
 
 int GuidingField::lookupMedium(const glm::vec3&) const { return -1; }
@@ -155,6 +159,7 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
 bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParams* hp,
                      double* maxMiB, std::string* error) {
     for (const auto& [key, value] : params) {
+        if (key == "target") hp->bootstrapTargets = value != "path";  // (validated elsewhere)
         const int shared = parseSharedParam("hemi", key, value, hp, maxMiB, error);
         if (shared < 0) return false;
         if (shared > 0) continue;

@@ -114,6 +114,11 @@ public:
     // direction outside the region's hemisphere): for one-sample estimates of the Eq. 1 sum.
     // bin: w's bin from pdf()/sample() for this region, or -1 (found from w).
     virtual float radiance(int region, const glm::vec3& w, int bin = -1) const = 0;
+    // radiance(region, w, bin) as far as the frozen policy alone tells it (the data sample()
+    // and pdf() read for the same region and w), for per-vertex decisions that need no exact
+    // Q, such as the integrator's roulette: a backend may answer it without loading its
+    // estimates. Finite and >= 0. Default: radiance().
+    virtual float policyRadiance(int region, const glm::vec3& w, int bin = -1) const;
 
     // How far the policy of `region` is trusted, in [0, 1] (0 for an invalid region): the
     // integrator multiplies its guide/BSDF mixture probability by it, so regions with little

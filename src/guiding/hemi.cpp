@@ -75,6 +75,12 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
                                              positions_.size() * 8);
     }
 
+    invCosine_.resize(size_t(strata_));
+    for (int j = 0; j < strata_; ++j)
+        invCosine_[size_t(j)] = params_.cosine ? 1.f / layout_.centre(j).z : 1.f;
+    uniformShare_ = float(params_.epsilon / strata_);
+    prefetchEstimates_ = params_.bootstrapTargets || !(params_.epsilon < 1.0);
+
     const size_t regions = positions_.size() * 2;
     frames_.resize(regions);
     for (size_t r = 0; r < regions; ++r) frames_[r].frame = HemiFrame::fromZ(regionNormal(int(r)));
@@ -136,12 +142,15 @@ int HemiField::prefetched(int region) const {
     __builtin_prefetch(&frames_[size_t(region)]);
     const float* c = cdf(region);
     for (int i = 0; i <= strata_; i += 16) __builtin_prefetch(c + i);
-    // And its estimates, which the integrator's roulette reads after the direction sample
-    // (cornell-box, 64 spp, perf: radiance() 705 -> 27 samples, prefetched() 0 -> 394,
-    // lookup() 789 -> 501, of about 15000; one line of the sampled stratum, prefetched at the
-    // sample, came too late: 705 -> 589).
-    const float* e = table_.estimates(size_t(region));
-    for (int i = 0; i < strata_; i += 16) __builtin_prefetch(e + i);
+    // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
+    // targets): a read without the prefetch waits (cornell-box, 64 spp, perf: radiance() 705
+    // -> 27 samples, prefetched() 0 -> 394, lookup() 789 -> 501, of about 15000). The
+    // roulette's policyRadiance reads the CDF instead: 16 prefetches less, -4.2% time
+    // (0.942 .. 0.974) with target=path (docs/BENCHMARKS.md, session 14).
+    if (prefetchEstimates_) {
+        const float* e = table_.estimates(size_t(region));
+        for (int i = 0; i < strata_; i += 16) __builtin_prefetch(e + i);
+    }
     return region;
 }
 
@@ -227,6 +236,16 @@ float HemiField::radiance(int region, const glm::vec3& w, int bin) const {
     return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
+float HemiField::policyRadiance(int region, const glm::vec3& w, int bin) const {
+    if (prefetchEstimates_) return radiance(region, w, bin);  // exact, and as cheap
+    const int j = stratumOf(region, w, bin);
+    if (j < 0) return 0.f;
+    const float* c = cdf(region);
+    const float q = (c[j + 1] - c[j] - uniformShare_) * frames_[size_t(region)].policyScale *
+                    invCosine_[size_t(j)];
+    return q > 0.f ? std::min(q, FLT_MAX) : 0.f;  // (NaN -> 0)
+}
+
 void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
@@ -243,6 +262,15 @@ void HemiField::updateRegion(int region, const double* q) {
     }
     RegionFrame& rf = frames_[size_t(region)];
     rf.confidence = table_.confidence(size_t(region), params_.warmup);
+    // buildPolicy's normalisation: p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n, or 1 / n
+    // where the sum is not positive and finite (then Q_j = 0 for all j).
+    double sum = 0.0;
+    for (int j = 0; j < strata_; ++j)
+        sum += params_.cosine ? q[j] * double(layout_.centre(j).z) : q[j];
+    const double scale = sum > 0.0 && std::isfinite(sum) && params_.epsilon < 1.0
+                             ? sum / (1.0 - params_.epsilon)
+                             : 0.0;
+    rf.policyScale = float(std::min(scale, double(FLT_MAX)));
     const double sa = layout_.stratumSolidAngle();
     const HemiFrame& f = rf.frame;
     glm::vec3 world;

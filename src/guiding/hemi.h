@@ -65,6 +65,10 @@ struct HemiParams {
     // (64 spp relMSE, seeds 2/3: veach-bidir 0.168/0.176 -> 0.165/0.159, breakfast 5.73/5.08
     // -> 5.27/4.49, buddha-fractal, killeroo, cornell-box within 1.5%).
     bool cellLookup = true;
+    // The integrator's target (the "target" parameter, which it validates): "path" (the
+    // default) reads no estimates per vertex; "sample" and "sum" read them for Eq. 1's
+    // bootstrap, so that the lookup prefetches them as well.
+    bool bootstrapTargets = false;
     // Prior strength, in visits, of the hierarchical smoothing of the strata estimates
     // (StrataTable::setSmoothing over StrataLayout::quadtree): a stratum with few visits
     // borrows the mean of the 2x2, 4x4, ... strata around it instead of keeping init. 0 = off
@@ -103,6 +107,11 @@ public:
                             const std::function<float(const glm::vec3&)>& fcos) const override;
     float irradianceEstimate(int region, const glm::vec3& n) const override;
     float radiance(int region, const glm::vec3& w, int bin = -1) const override;
+    // From the stratum's probability in the CDF and the region's policyScale: Q_j = (p_j -
+    // epsilon / n) * policyScale / cos_j (cos_j = 1 without the cosine product), equal to
+    // radiance() up to the CDF's float rounding, about 1e-7 of the region's cosine-weighted
+    // total divided by cos_j. (radiance() with epsilon = 1, where the CDF holds no Q.)
+    float policyRadiance(int region, const glm::vec3& w, int bin = -1) const override;
     float confidence(int region) const override;
     float selection(int region) const override;
     void recordSelection(int slot, int region, const SelectionSample& s) override;
@@ -182,13 +191,23 @@ private:
     std::unique_ptr<PointKdTree> tree_;
     std::unique_ptr<CellCache> cache_;  // lookup=cell only
     // Per region, one cache line: the frame of its hemisphere (z = normal), the moment
-    // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, and its confidence.
+    // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, its confidence, and the scale
+    // that turns a stratum's probability back into its Q (policyRadiance).
     struct alignas(64) RegionFrame {
         HemiFrame frame;
         glm::vec3 moment{0.f};
-        float confidence = 0.f;  // visits / (visits + warmup * strata), frozen per pass
+        float confidence = 0.f;   // visits / (visits + warmup * strata), frozen per pass
+        float policyScale = 0.f;  // sum_j Q_j cos_j / (1 - epsilon); 0 for a uniform CDF
     };
     std::vector<RegionFrame> frames_;
+    // Per stratum, 1 / the cosine factor of the policy (1 without the cosine product), and
+    // the uniform share of every stratum's probability, epsilon / n: for policyRadiance.
+    std::vector<float> invCosine_;
+    float uniformShare_ = 0.f;
+    // The integrator reads the estimates at every vertex (target=sample or sum, for Eq. 1's
+    // bootstrap; epsilon = 1, where policyRadiance reads them): the lookup prefetches them
+    // too. With target=path and epsilon < 1 it reads the CDF only (policyRadiance).
+    bool prefetchEstimates_ = false;
     StrataTable table_;              // Q, float Q, visits, CDFs, record buffers, counters
     uint64_t attempts_ = 0;  // samplePoint calls made at construction
 };

@@ -573,6 +573,68 @@ TEST(HemiField, BinsFromPdfAndSampleStandForTheDirection) {
     EXPECT_EQ(bin, -1);
 }
 
+// policyRadiance (the roulette's Q, from the CDF) against radiance (the estimates): equal up
+// to the CDF's float rounding, whose bound is derived here: each CDF entry is a double
+// rounded to float (at most 2^-25 absolutely, entries <= 1), the difference of two of them
+// rounds by at most 2^-24 of itself, and the bound carries the region's scale
+// sum_k Q_k cos_k / (1 - epsilon) over the stratum's cosine. Where the CDF holds no Q
+// (epsilon = 1) and where the integrator reads the estimates anyway (target=sample), it is
+// radiance() exactly.
+TEST(HemiField, PolicyRadianceMatchesTheEstimates) {
+    struct Case {
+        std::map<std::string, std::string> params;
+        bool exact;
+    };
+    const std::vector<Case> cases = {
+        {{{"points", "4"}}, false},
+        {{{"points", "4"}, {"strata", "7x5"}, {"cosine", "0"}}, false},
+        {{{"points", "4"}, {"epsilon", "0"}, {"smooth", "0"}}, false},
+        {{{"points", "4"}, {"epsilon", "0.5"}, {"strata", "64x64"}}, false},
+        {{{"points", "4"}, {"epsilon", "1"}}, true},
+        {{{"points", "4"}, {"target", "sample"}}, true},
+    };
+    for (const Case& c : cases) {
+        auto f = makeHemi(planeScene(), c.params);
+        ASSERT_TRUE(f);
+        std::string what;
+        for (const auto& [k, v] : c.params) what += k + "=" + v + " ";
+        const glm::vec3 bright = glm::normalize(glm::vec3(0.3f, -0.2f, 1.f));
+        trainBright(*f, 0, bright, 2, 7);
+        const double eps = c.params.count("epsilon") ? std::stod(c.params.at("epsilon")) : 0.1;
+        const bool cosine = !c.params.count("cosine");
+        for (int region : {0, 2}) {  // trained, untrained
+            const int n = f->layout().count();
+            double sum = 0.0;
+            for (int j = 0; j < n; ++j)
+                sum += f->radiance(region, strataCentre(*f, region, j)) *
+                       (cosine ? f->layout().centre(j).z : 1.0);
+            int nonzero = 0;
+            for (int j = 0; j < n; ++j) {
+                const glm::vec3 w = strataCentre(*f, region, j);
+                const float exact = f->radiance(region, w);
+                int bin = -1;
+                f->pdf(region, w, &bin);
+                const float approx = f->policyRadiance(region, w, bin);
+                ASSERT_EQ(approx, f->policyRadiance(region, w)) << what << j;
+                nonzero += exact > 0.f;
+                if (c.exact) {
+                    ASSERT_EQ(approx, exact) << what << j;
+                    continue;
+                }
+                const double cosj = cosine ? f->layout().centre(j).z : 1.0;
+                const double tol = 3.0 * std::ldexp(1.0, -24) * sum / (1.0 - eps) / cosj +
+                                   1e-6 * exact;
+                ASSERT_NEAR(approx, exact, tol) << what << " region " << region << " stratum " << j;
+                ASSERT_GE(approx, 0.f);
+            }
+            EXPECT_EQ(nonzero, n) << what;  // init > 0 and smoothing keep every Q positive
+        }
+        // Outside the hemisphere, and for no region: 0.
+        EXPECT_EQ(f->policyRadiance(0, -f->regionNormal(0)), 0.f) << what;
+        EXPECT_EQ(f->policyRadiance(-1, glm::vec3(0, 0, 1)), 0.f) << what;
+    }
+}
+
 TEST(HemiField, FixedAlphaFollowsGeometricSchedule) {
     const std::vector<std::pair<double, std::string>> alphas = {
         {1.0, "1"}, {0.5, "0.5"}, {0.1, "0.1"}, {1e-9, "1e-9"}};
