@@ -139,9 +139,9 @@ int HemiField::prefetched(int region) const {
     // random place in tables larger than the L2 cache: start loading them now (the caller does
     // other work, e.g. a shadow ray, before its first query). Measured on cornell-box, 16 spp:
     // -17% profile samples of a guided render.
-    __builtin_prefetch(&frames_[size_t(region)]);
+    prefetchLine(&frames_[size_t(region)]);
     const float* c = cdf(region);
-    for (int i = 0; i <= strata_; i += 16) __builtin_prefetch(c + i);
+    for (int i = 0; i <= strata_; i += 16) prefetchLine(c + i);
     // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
     // targets): a read without the prefetch waits (cornell-box, 64 spp, perf: radiance() 705
     // -> 27 samples, prefetched() 0 -> 394, lookup() 789 -> 501, of about 15000). The
@@ -149,7 +149,7 @@ int HemiField::prefetched(int region) const {
     // (0.942 .. 0.974) with target=path (docs/BENCHMARKS.md, session 14).
     if (prefetchEstimates_) {
         const float* e = table_.estimates(size_t(region));
-        for (int i = 0; i < strata_; i += 16) __builtin_prefetch(e + i);
+        for (int i = 0; i < strata_; i += 16) prefetchLine(e + i);
     }
     return region;
 }
