@@ -7,8 +7,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "guiding/slot_merge.h"
-
 namespace rlpbrt::guiding {
 
 void SelectionLearner::reset(size_t regions) {

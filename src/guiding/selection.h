@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "guiding/guiding.h"
+#include "guiding/slot_merge.h"
 
 namespace rlpbrt::guiding {
 
@@ -73,7 +74,7 @@ private:
     std::vector<double> weights_;  // decayed sample count per region
     std::vector<float> selection_;
     std::vector<uint64_t> start_;  // endPass scratch: counting sort by region
-    std::vector<Sample> merged_;
+    MergedRecords<Sample> merged_;
 };
 
 }  // namespace rlpbrt::guiding

@@ -7,8 +7,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "guiding/slot_merge.h"
-
 namespace rlpbrt::guiding {
 
 void StrataTable::reset(size_t regions, int strata, double init, const PolicyBuilder& policy,

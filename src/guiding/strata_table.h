@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "guiding/guiding.h"
+#include "guiding/slot_merge.h"
 #include "guiding/selection.h"
 
 namespace rlpbrt::guiding {
@@ -175,7 +176,7 @@ private:
     std::vector<float> cdf_;
     std::vector<SlotBuffer> slots_;
     std::vector<uint64_t> regionStart_;
-    std::vector<Record> merged_;
+    MergedRecords<Record> merged_;
     GuidingStats stats_;
     SelectionLearner selection_;
 };
