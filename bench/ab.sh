@@ -8,7 +8,9 @@
 # distribution over the log ratios). Pairs, not sequential runs: the VM's speed drifts by up
 # to 40% between minutes, but the two renders of a pair share it. A ratio's interval that
 # contains 1 is no difference. Environment: OPTS_A / OPTS_B (extra options for one side),
-# SHARED (default ../shared), SEED (default 3).
+# SHARED (default ../shared), SEED (default 3), SEQUENTIAL=1: each render alone with all
+# cores (the renderer's default threads), A then B, B then A on alternate pairs: the time a
+# user's render takes, serial work between passes included (a one-thread render has none).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 shared=${SHARED:-$here/../shared}
@@ -31,23 +33,38 @@ fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 run() {  # core binary tag extra-options
+    local pin=(taskset -c "$1") threads=(--nthreads 1)
+    [[ ${SEQUENTIAL:-0} == 1 ]] && pin=() threads=()
     # shellcheck disable=SC2086
-    taskset -c "$1" "$2" "$scene" --spp "$spp" --nthreads 1 --quiet --seed "${SEED:-3}" \
+    "${pin[@]}" "$2" "$scene" --spp "$spp" "${threads[@]}" --quiet --seed "${SEED:-3}" \
         -o "$tmp/$3.exr" --stats "$tmp/$3.json" "${@:5}" $4 >/dev/null 2>"$tmp/$3.log"
 }
 ratios=()
 for ((i = 0; i < pairs; i++)); do
     ca=$((i % 2)); cb=$((1 - i % 2))
-    run "$ca" "$a" A "${OPTS_A:-}" "$@" &
-    pa=$!
-    run "$cb" "$b" B "${OPTS_B:-}" "$@" &
-    pb=$!
-    wait "$pa" || { cat "$tmp/A.log" >&2; exit 1; }
-    wait "$pb" || { cat "$tmp/B.log" >&2; exit 1; }
+    if [[ ${SEQUENTIAL:-0} == 1 ]]; then
+        order=(A B)
+        ((i % 2 == 1)) && order=(B A)
+        for side in "${order[@]}"; do
+            if [[ $side == A ]]; then bin=$a opts=${OPTS_A:-}; else bin=$b opts=${OPTS_B:-}; fi
+            run - "$bin" "$side" "$opts" "$@" || { cat "$tmp/$side.log" >&2; exit 1; }
+        done
+    else
+        run "$ca" "$a" A "${OPTS_A:-}" "$@" &
+        pa=$!
+        run "$cb" "$b" B "${OPTS_B:-}" "$@" &
+        pb=$!
+        wait "$pa" || { cat "$tmp/A.log" >&2; exit 1; }
+        wait "$pb" || { cat "$tmp/B.log" >&2; exit 1; }
+    fi
     r=$(/usr/bin/python3 -c 'import json,sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 print("%.4f" % (b["seconds"] / a["seconds"]))' "$tmp/A.json" "$tmp/B.json")
-    echo "pair $((i + 1)) (A on core $ca): B / A = $r"
+    if [[ ${SEQUENTIAL:-0} == 1 ]]; then
+        echo "pair $((i + 1)) (${order[0]} first): B / A = $r"
+    else
+        echo "pair $((i + 1)) (A on core $ca): B / A = $r"
+    fi
     ratios+=("$r")
 done
 /usr/bin/python3 - "${ratios[@]}" <<'EOF'
