@@ -19,9 +19,9 @@
 namespace rlpbrt::guiding {
 
 // Starts loading the cache line at `addr` into every cache level (no effect on results). GCC
-// 12 at -O2 with NDEBUG drops a __builtin_prefetch whose address is computed from a float
-// difference converted to an integer, as keyOf's is (HemiField::prefetch compiled to a bare
-// `ret` until session 14), so on x86 the instruction is written out.
+// 12 drops a __builtin_prefetch whose address is computed from a float difference converted
+// to an integer, as keyOf's is (with NDEBUG, HemiField::prefetch compiled to a bare `ret`
+// until session 14), so on x86 the instruction is written out.
 inline void prefetchLine(const void* addr) {
 #if defined(__x86_64__) || defined(__i386__)
     asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char*>(addr)));
