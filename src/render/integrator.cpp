@@ -637,7 +637,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
             sampleRegion >= 0 && !ds.transmission &&
             field->confidence(sampleRegion) >= kRouletteConfidence) {
-            const float expected = luminance(beta) * field->policyRadiance(sampleRegion, ds.wi, ds.bin);
+            const float expected =
+                luminance(beta) * field->policyRadiance(sampleRegion, ds.wi, ds.bin);
             const float low = guide_.rouletteWindow * pixelEstimate;
             if (expected < low) {
                 const float survive = std::max(expected / low, kMinSurvival);
