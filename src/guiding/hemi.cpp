@@ -77,7 +77,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
 
     invCosine_.resize(size_t(strata_));
     for (int j = 0; j < strata_; ++j)
-        invCosine_[size_t(j)] = params_.cosine ? 1.f / layout_.centre(j).z : 1.f;
+        invCosine_[size_t(j)] = 1.f / float(policyWeight(j));
     uniformShare_ = float(params_.epsilon / strata_);
     prefetchEstimates_ = params_.bootstrapTargets || !(params_.epsilon < 1.0);
 
@@ -265,8 +265,7 @@ void HemiField::updateRegion(int region, const double* q) {
     // buildPolicy's normalisation: p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n, or 1 / n
     // where the sum is not positive and finite (then Q_j = 0 for all j).
     double sum = 0.0;
-    for (int j = 0; j < strata_; ++j)
-        sum += params_.cosine ? q[j] * double(layout_.centre(j).z) : q[j];
+    for (int j = 0; j < strata_; ++j) sum += q[j] * policyWeight(j);
     const double scale = sum > 0.0 && std::isfinite(sum) && params_.epsilon < 1.0
                              ? sum / (1.0 - params_.epsilon)
                              : 0.0;
@@ -287,7 +286,7 @@ void HemiField::buildPolicy(const double* q, float* cdf) const {
         return;
     }
     double qc[64 * 64];
-    for (int j = 0; j < strata_; ++j) qc[j] = q[j] * double(layout_.centre(j).z);
+    for (int j = 0; j < strata_; ++j) qc[j] = q[j] * policyWeight(j);
     buildStrataCdf(qc, strata_, params_.epsilon, cdf);
 }
 

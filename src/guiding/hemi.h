@@ -164,6 +164,11 @@ public:
 private:
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;
+    // The factor of stratum j's Q in the policy: its centre's cosine, or 1 without the cosine
+    // product (buildPolicy, and policyRadiance's inverse).
+    double policyWeight(int j) const {
+        return params_.cosine ? double(layout_.centre(j).z) : 1.0;
+    }
     // Starts loading the data the per-vertex queries read for a region; returns region.
     int prefetched(int region) const;
     // Refreshes a region's moment (from its estimates q) and confidence (after a CDF build).
