@@ -7,8 +7,8 @@
 # pair's ratio of render seconds B / A (and of mean path length, from --stats), then geometric
 # means with 95% intervals (t distribution over the log ratios) of the path length, of the
 # seconds per path vertex (what B's vertices cost against A's, apart from longer or shorter
-# paths) and, last, of the seconds (the overhead per sample). Pairs, not sequential runs: the VM's speed drifts by up
-# to 40% between minutes, but the two renders of a pair share it. A ratio's interval that
+# paths) and, last, of the seconds (the overhead per sample). Pairs, not sequential runs:
+# the VM's speed drifts by up to 40% between minutes, but the two renders of a pair share it. A ratio's interval that
 # contains 1 is no difference. Environment: OPTS_A / OPTS_B (extra options for one side),
 # SHARED (default ../shared), SEED (default 3), SEQUENTIAL=1: each render alone with all
 # cores (the renderer's default threads), A then B, B then A on alternate pairs: the time a
