@@ -2,17 +2,17 @@
 # A/B speed of two rlpbrt binaries (or two option sets) on one scene, robust to a shared VM:
 #   bench/ab.sh BIN_A BIN_B SCENE [PAIRS] [SPP] -- [rlpbrt options...]
 # Runs PAIRS (default 8) pairs: A and B render the same SCENE (a path, or a scene id of
-# ../shared/references/manifest.tsv) at the same time, one thread each, pinned to cores 0 and
-# 1, swapping the cores every pair, each for SPP samples per pixel (default 128). Prints each
-# pair's ratio of render seconds B / A (and of mean path length, from --stats), then geometric
-# means with 95% intervals (t distribution over the log ratios) of the path length, of the
-# seconds per path vertex (what B's vertices cost against A's, apart from longer or shorter
-# paths) and, last, of the seconds (the overhead per sample). Pairs, not sequential runs:
-# the VM's speed drifts by up to 40% between minutes, but the two renders of a pair share it. A ratio's interval that
-# contains 1 is no difference. Environment: OPTS_A / OPTS_B (extra options for one side),
-# SHARED (default ../shared), SEED (default 3), SEQUENTIAL=1: each render alone with all
-# cores (the renderer's default threads), A then B, B then A on alternate pairs: the time a
-# user's render takes, serial work between passes included (a one-thread render has none).
+# ../shared/references/manifest.tsv) at the same time, one thread each, pinned to cores 0 and 1,
+# swapping the cores every pair, each for SPP samples per pixel (default 128). Prints each pair's
+# ratio of render seconds B / A (and of mean path length, from --stats), then geometric means with
+# 95% intervals (t distribution over the log ratios) of the path length, of the seconds per path
+# vertex (what B's vertices cost against A's, apart from longer or shorter paths) and, last, of the
+# seconds (the overhead per sample). Pairs, not sequential runs: the VM's speed drifts by up to 40%
+# between minutes, but the two renders of a pair share it. A ratio's interval that contains 1 is no
+# difference. Environment: OPTS_A / OPTS_B (extra options for one side), SHARED (default ../shared),
+# SEED (default 3), SEQUENTIAL=1: each render alone with all cores (the renderer's default threads),
+# A then B, B then A on alternate pairs: the time a user's render takes, serial work between passes
+# included (a one-thread render has none).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 shared=${SHARED:-$here/../shared}
