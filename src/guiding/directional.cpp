@@ -4,7 +4,8 @@
 
 namespace rlpbrt::guiding {
 
-StrataLayout::StrataLayout(int cols, int rows) : cols_(cols), rows_(rows) {
+StrataLayout::StrataLayout(int cols, int rows)
+    : cols_(cols), rows_(rows), density_(static_cast<float>(cols * rows / (2.0 * kPi))) {
     octantShift_ = cols == 2 ? 2 : cols == 4 ? 1 : (cols == 8 || cols == 16) ? 0 : -1;
     centres_.resize(static_cast<size_t>(cols) * static_cast<size_t>(rows));
     for (int row = 0; row < rows; ++row) {

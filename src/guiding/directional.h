@@ -85,6 +85,9 @@ public:
     int count() const { return cols_ * rows_; }
     // Solid angle of one stratum in steradians: 2 pi / count().
     double stratumSolidAngle() const { return 2.0 * kPi / count(); }
+    // Its inverse as a float, count() / (2 pi): a stratum's density per steradian is its
+    // probability times this (computed once: the pdfs would divide on every call).
+    float density() const { return density_; }
 
     // Stratum of a unit local direction; -1 if local.z <= 0 or NaN (or phi is NaN).
     // cos(theta) = 1 and phi = 2 pi are clamped into the last row/column.
@@ -164,6 +167,7 @@ public:
 
 private:
     int cols_, rows_;
+    float density_;
     // column = octant >> this for 2, 4, 8 columns (2, 1, 0); 0 also for 16 columns (the
     // octant's halves); else -1 (the azimuth)
     int octantShift_ = -1;

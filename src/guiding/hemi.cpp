@@ -64,6 +64,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         positions_.swap(pos);
         normals_.swap(nrm);
     }
+    numRegions_ = static_cast<int>(normals_.size() * 2);
     tree_ = std::make_unique<PointKdTree>(positions_);
     if (params_.cellLookup && !positions_.empty() && params_.knn <= CellCache::kMaxCandidates) {
         // Cells as large as the points' mean spacing: about one to three cells per point's
@@ -164,8 +165,7 @@ float HemiField::pdf(int region, const glm::vec3& w, int* bin) const {
     const int j = stratumOf(region, w);
     if (bin) *bin = j;
     if (j < 0) return 0.f;
-    return strataProbability(cdf(region), j) *
-           static_cast<float>(strata_ / (2.0 * kPi));
+    return strataProbability(cdf(region), j) * layout_.density();
 }
 
 glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut,
@@ -178,7 +178,7 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfO
     const float* c = cdf(region);
     int j = sampleStrataCdf(c, strata_, uStratum);
     glm::vec3 w = glm::normalize(frames_[size_t(region)].frame.toWorld(layout_.sampleStratum(j, u)));
-    const float density = strataProbability(c, j) * static_cast<float>(strata_ / (2.0 * kPi));
+    const float density = strataProbability(c, j) * layout_.density();
     // Report exactly pdf(region, w), so that MIS weights computed later agree; rounding may
     // move a direction on a stratum edge to its neighbour. Away from the edges (u at least
     // kEdge inside, so that with up to 64x64 strata w is at least 1.5e-5 in cos(theta) and

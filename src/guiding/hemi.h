@@ -133,7 +133,7 @@ public:
     // untrained prior's).
     size_t learnedRegions() const { return table_.learnedRegions(); }
     // Number of regions (hemispheres): twice the number of accepted surface points.
-    int numRegions() const { return static_cast<int>(normals_.size() * 2); }
+    int numRegions() const { return numRegions_; }
     const StrataLayout& layout() const { return layout_; }
     const HemiParams& params() const { return params_; }
     // The lookup's cell memo (null with lookup=exact, or knn > CellCache::kMaxCandidates).
@@ -193,6 +193,7 @@ private:
     float cosMaxAngle_;
     std::vector<glm::vec3> positions_;  // one per surface sample
     std::vector<glm::vec3> normals_;    // unit geometric normal per surface sample
+    int numRegions_ = 0;                // 2 x the points (validRegion on every query)
     std::unique_ptr<PointKdTree> tree_;
     std::unique_ptr<CellCache> cache_;  // lookup=cell only
     // Per region, one cache line: the frame of its hemisphere (z = normal), the moment

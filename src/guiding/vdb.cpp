@@ -387,8 +387,7 @@ float VdbField::pdf(int region, const glm::vec3& w, int* bin) const {
     const int j = stratumOf(region, w);
     if (bin) *bin = j;
     if (j < 0) return 0.f;
-    return strataProbability(table_.cdf(size_t(region)), j) *
-           static_cast<float>(layout_.count() / (2.0 * kPi));
+    return strataProbability(table_.cdf(size_t(region)), j) * layout_.density();
 }
 
 glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut,
@@ -401,14 +400,13 @@ glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOu
         return glm::vec3(0.f);
     }
     const float* c = table_.cdf(size_t(region));
-    const int n = layout_.count();
     const int j = sampleStrataCdf(c, table_.strata(), uStratum);
     glm::vec3 local = layout_.sampleSphereStratum(j, u);
     glm::vec3 w = glm::normalize(frames_[size_t(region)].toWorld(local));
     // Report exactly pdf(region, w) (rounding may move w across a stratum edge); on the
     // hemisphere's rim (pdf 0) keep the drawn stratum's density, as hemi does.
     float p = pdf(region, w, bin);
-    if (!(p > 0.f)) p = strataProbability(c, j) * static_cast<float>(n / (2.0 * kPi));
+    if (!(p > 0.f)) p = strataProbability(c, j) * layout_.density();
     *pdfOut = p;
     return w;
 }

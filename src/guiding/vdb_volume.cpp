@@ -69,8 +69,7 @@ float VdbVolume::pdf(int cell, const glm::vec3& w) const {
     if (cell < 0 || cell >= cells()) return 0.f;
     const int j = stratumOf(w);
     if (j < 0) return 0.f;
-    return strataProbability(table_.cdf(size_t(cell)), j) *
-           float(double(layout_.count()) / (2.0 * kPi));
+    return strataProbability(table_.cdf(size_t(cell)), j) * layout_.density();
 }
 
 glm::vec3 VdbVolume::sample(int cell, glm::vec2 u, float uStratum, float* pdfOut) const {
@@ -79,12 +78,11 @@ glm::vec3 VdbVolume::sample(int cell, glm::vec2 u, float uStratum, float* pdfOut
         return glm::vec3(0.f);
     }
     const float* c = table_.cdf(size_t(cell));
-    const int n = layout_.count();
     const int j = sampleStrataCdf(c, table_.strata(), uStratum);
     const glm::vec3 w = glm::normalize(layout_.sampleSphereStratum(j, u));
     // Report exactly pdf(cell, w); on the equator (measure zero) keep the drawn stratum's.
     float p = pdf(cell, w);
-    if (!(p > 0.f)) p = strataProbability(c, j) * float(double(n) / (2.0 * kPi));
+    if (!(p > 0.f)) p = strataProbability(c, j) * layout_.density();
     *pdfOut = p;
     return w;
 }

@@ -204,19 +204,20 @@ struct PendingRecord {
 };
 }  // namespace
 
-float PathIntegrator::directionPdf(const BSDF& bsdf, int region, float share, const Vec3& wo,
+float PathIntegrator::directionPdf(const BSDF& bsdf, VertexGuide& guide, const Vec3& wo,
                                    const Vec3& wi) const {
     float pb = bsdf.pdf(wo, wi);
-    if (region < 0) return pb;
-    const float mix = guideProbability(region, share);
-    return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * pb : pb;
+    if (guide.region < 0) return pb;
+    const float mix = guideMix(guide);
+    return mix > 0.f ? mix * guide_.field->pdf(guide.region, wi) + (1.f - mix) * pb : pb;
 }
 
 PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
-                                                                const BSDF& bsdf, int region,
-                                                                float share,
+                                                                const BSDF& bsdf,
+                                                                VertexGuide& guide,
                                                                 Sampler& sampler) const {
     DirectionSample ds;
+    const int region = guide.region;
     float uc = sampler.get1D();
     Vec2 u = sampler.get2D();
     if (region < 0) {
@@ -230,7 +231,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
-    const float mix = guideProbability(region, share, &ds.scale);
+    const float mix = guideMix(guide);
+    ds.scale = guide.scale;
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
@@ -255,8 +257,8 @@ PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInt
     return ds;
 }
 
-Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                     float share, Sampler& sampler, PathStats& stats,
+Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf,
+                                     VertexGuide& guide, Sampler& sampler, PathStats& stats,
                                      const PathMedium* media) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
@@ -281,7 +283,7 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     }
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, region, share, si.wo, ls.wi));
+    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, guide, si.wo, ls.wi));
     return f * ls.L * (w / lightPdf);
 }
 
@@ -570,12 +572,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const float share =
             region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(bsdf, lobes) : 0.f;
         const int sampleRegion = share > 0.f ? region : -1;
+        VertexGuide vertexGuide{sampleRegion, share};
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
         if (!lastVertex) {
             ++stats.vertices;
             if (smoothLobes > 0)
-                L += beta * sampleLight(si, bsdf, sampleRegion, share, sampler, stats,
+                L += beta * sampleLight(si, bsdf, vertexGuide, sampler, stats,
                                         media ? &pm : nullptr);
         }
         // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
@@ -594,7 +597,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         if (lastVertex) break;
         // Sample the next direction (the guiding seam).
-        DirectionSample ds = sampleDirection(si, bsdf, sampleRegion, share, sampler);
+        DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
         if (deferTarget) {
             // One-sample estimate of the Eq. 1 sum: Q(y, w') f(w') cos / pdf(w').
             float est = 0.f;

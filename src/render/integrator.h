@@ -135,12 +135,24 @@ private:
         // The guide's bin of wi in the region it was drawn with (GuidingField::pdf), or -1.
         int bin = -1;
     };
-    // `share`: the BSDF's diffuse share; the probability of a guided sample is
-    // guideProbability(region, share) (region < 0: BSDF only). The region's confidence is
-    // read here, late, so that the lookup's prefetch of its cache line has landed.
-    DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                    float share, Sampler& sampler) const;
-    float directionPdf(const BSDF& bsdf, int region, float share, const Vec3& wo,
+    // The guide at a surface vertex: its region (-1: BSDF only) and the BSDF's diffuse share;
+    // the probability of a guided sample, guideProbability(region, share), is found at its
+    // first use (NEE's MIS weight or the direction sample) and kept for the other: the
+    // region's confidence is read late, so that the lookup's prefetch of its cache line has
+    // landed, and once.
+    struct VertexGuide {
+        int region = -1;
+        float share = 0.f;
+        float mix = -1.f;   // guideProbability, once found
+        float scale = 0.f;  // its confidence x share
+    };
+    float guideMix(VertexGuide& g) const {
+        if (g.mix < 0.f) g.mix = guideProbability(g.region, g.share, &g.scale);
+        return g.mix;
+    }
+    DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
+                                    VertexGuide& guide, Sampler& sampler) const;
+    float directionPdf(const BSDF& bsdf, VertexGuide& guide, const Vec3& wo,
                        const Vec3& wi) const;
     // Probability of a guided sample at a region: its selection times *scale = its
     // confidence times `share` (the BSDF's diffuse share; 1 in a medium); 0 without a region.
@@ -164,7 +176,7 @@ private:
         int medium = -1;
         Rng* rng = nullptr;
     };
-    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, int region, float share,
+    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, VertexGuide& guide,
                          Sampler& sampler, PathStats& stats,
                          const PathMedium* media = nullptr) const;
     // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
