@@ -305,18 +305,20 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
     return tr;
 }
 
-float PathIntegrator::mediumDirectionPdf(float phase, int region, const Vec3& wi) const {
-    const float mix = guideProbability(region, 1.f);
-    return mix > 0.f ? mix * guide_.field->pdf(region, wi) + (1.f - mix) * phase : phase;
+float PathIntegrator::mediumDirectionPdf(float phase, VertexGuide& guide, const Vec3& wi) const {
+    const float mix = guideMix(guide);
+    return mix > 0.f ? mix * guide_.field->pdf(guide.region, wi) + (1.f - mix) * phase : phase;
 }
 
 PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
-                                                                      int region,
+                                                                      VertexGuide& guide,
                                                                       Sampler& sampler) const {
     DirectionSample ds;
+    const int region = guide.region;
     const float uc = guide_.field ? sampler.get1D() : 1.f;
     const Vec2 u = sampler.get2D();
-    const float mix = guideProbability(region, 1.f, &ds.scale);
+    const float mix = guideMix(guide);
+    ds.scale = guide.scale;
     float pGuide = 0.f, pPhase = 0.f;
     if (uc < mix) {
         ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide,
@@ -336,9 +338,9 @@ PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3
     return ds;
 }
 
-Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g, int region,
-                                           const PathMedium& pm, Sampler& sampler,
-                                           PathStats& stats) const {
+Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g,
+                                           VertexGuide& guide, const PathMedium& pm,
+                                           Sampler& sampler, PathStats& stats) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
     float pmf;
@@ -355,7 +357,8 @@ Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float 
     if (ls.isDelta) return phase * tr * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
     float w = powerHeuristic(1, lightPdf, 1,
-                             region >= 0 ? mediumDirectionPdf(phase, region, ls.wi) : phase);
+                             guide.region >= 0 ? mediumDirectionPdf(phase, guide, ls.wi)
+                                               : phase);
     return phase * tr * ls.L * (w / lightPdf);
 }
 
@@ -481,8 +484,9 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 }
                 const int sampleRegion = guide_.mix > 0.f ? region : -1;
                 ++stats.vertices;
-                L += beta * sampleLightMedium(p, wo, medium.g(), sampleRegion, pm, sampler, stats);
-                DirectionSample ds = sampleMediumDirection(wo, medium.g(), sampleRegion, sampler);
+                VertexGuide vertexGuide{sampleRegion, 1.f};
+                L += beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, pm, sampler, stats);
+                DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, sampler);
                 if (learn) {
                     // Eq. 1 for the previous vertex, with the one-sample estimate of the
                     // light scattered here: Q(p, w') phase(w') / pdf(w').
@@ -639,7 +643,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // knows it.
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
             sampleRegion >= 0 && !ds.transmission &&
-            field->confidence(sampleRegion) >= kRouletteConfidence) {
+            guideConfidence(vertexGuide) >= kRouletteConfidence) {
             const float expected =
                 luminance(beta) * field->policyRadiance(sampleRegion, ds.wi, ds.bin);
             const float low = guide_.rouletteWindow * pixelEstimate;

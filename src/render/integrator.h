@@ -135,33 +135,35 @@ private:
         // The guide's bin of wi in the region it was drawn with (GuidingField::pdf), or -1.
         int bin = -1;
     };
-    // The guide at a surface vertex: its region (-1: BSDF only) and the BSDF's diffuse share;
-    // the probability of a guided sample, guideProbability(region, share), is found at its
-    // first use (NEE's MIS weight or the direction sample) and kept for the other: the
-    // region's confidence is read late, so that the lookup's prefetch of its cache line has
-    // landed, and once.
+    // The guide at a vertex: its region (-1: BSDF or phase function only) and the BSDF's
+    // diffuse share (1 in a medium). guideMix() finds the probability of a guided sample at
+    // its first use (NEE's MIS weight or the direction sample) and keeps it, with the
+    // region's confidence, for the other uses (and the roulette): the confidence is read
+    // late, so that the lookup's prefetch of its cache line has landed, and once. Sampling
+    // and pdf evaluation thus agree to the bit.
     struct VertexGuide {
         int region = -1;
         float share = 0.f;
-        float mix = -1.f;   // guideProbability, once found
-        float scale = 0.f;  // its confidence x share
+        float mix = -1.f;         // the guide probability: selection x scale, once found
+        float confidence = 0.f;   // the region's
+        float scale = 0.f;        // confidence x share
     };
     float guideMix(VertexGuide& g) const {
-        if (g.mix < 0.f) g.mix = guideProbability(g.region, g.share, &g.scale);
+        if (g.mix < 0.f) {
+            g.confidence = g.region >= 0 ? guide_.field->confidence(g.region) : 0.f;
+            g.scale = g.region >= 0 ? g.confidence * g.share : 0.f;
+            g.mix = g.region >= 0 ? regionSelection(g.region) * g.scale : 0.f;
+        }
         return g.mix;
+    }
+    float guideConfidence(VertexGuide& g) const {
+        guideMix(g);
+        return g.confidence;
     }
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
                                     VertexGuide& guide, Sampler& sampler) const;
     float directionPdf(const BSDF& bsdf, VertexGuide& guide, const Vec3& wo,
                        const Vec3& wi) const;
-    // Probability of a guided sample at a region: its selection times *scale = its
-    // confidence times `share` (the BSDF's diffuse share; 1 in a medium); 0 without a region.
-    // Sampling and pdf evaluation both call it, so they agree to the bit.
-    float guideProbability(int region, float share, float* scale = nullptr) const {
-        const float sc = region >= 0 ? guide_.field->confidence(region) * share : 0.f;
-        if (scale) *scale = sc;
-        return region >= 0 ? regionSelection(region) * sc : 0.f;
-    }
     // The selection probability of a region: learned (mix=learn, where the field has one) or
     // the mix setting.
     float regionSelection(int region) const {
@@ -181,15 +183,15 @@ private:
                          const PathMedium* media = nullptr) const;
     // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
     // against the vertex's direction sampling (phase, or the guide mixed with it at a region).
-    Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, int region,
+    Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, VertexGuide& guide,
                                const PathMedium& pm, Sampler& sampler, PathStats& stats) const;
     // The direction-sampling seam at a medium vertex: the phase function, or at a region the
-    // guide with probability guideProbability, mixed with it (f = the phase value; one 1D dimension
+    // guide with probability guideMix, mixed with it (f = the phase value; one 1D dimension
     // more when a field is set). And the pdf of that strategy for wi, whose phase value is
     // `phase`.
-    DirectionSample sampleMediumDirection(const Vec3& wo, float g, int region,
+    DirectionSample sampleMediumDirection(const Vec3& wo, float g, VertexGuide& guide,
                                           Sampler& sampler) const;
-    float mediumDirectionPdf(float phase, int region, const Vec3& wi) const;
+    float mediumDirectionPdf(float phase, VertexGuide& guide, const Vec3& wi) const;
     // Transmittance of the segment o + t d, t in (0, tMax), starting in `medium`: through
     // medium boundaries (interface-only surfaces), zero at any other surface.
     Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
