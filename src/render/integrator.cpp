@@ -204,14 +204,6 @@ struct PendingRecord {
 };
 }  // namespace
 
-float PathIntegrator::directionPdf(const BSDF& bsdf, VertexGuide& guide, const Vec3& wo,
-                                   const Vec3& wi) const {
-    float pb = bsdf.pdf(wo, wi);
-    if (guide.region < 0) return pb;
-    const float mix = guideMix(guide);
-    return mix > 0.f ? mix * guide_.field->pdf(guide.region, wi) + (1.f - mix) * pb : pb;
-}
-
 PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
                                                                 const BSDF& bsdf,
                                                                 VertexGuide& guide,
@@ -283,7 +275,7 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     }
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1, directionPdf(bsdf, guide, si.wo, ls.wi));
+    float w = powerHeuristic(1, lightPdf, 1, mixturePdf(guide, ls.wi, bsdf.pdf(si.wo, ls.wi)));
     return f * ls.L * (w / lightPdf);
 }
 
@@ -303,11 +295,6 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
         if (!(tMax > 0.f)) return tr;
     }
     return tr;
-}
-
-float PathIntegrator::mediumDirectionPdf(float phase, VertexGuide& guide, const Vec3& wi) const {
-    const float mix = guideMix(guide);
-    return mix > 0.f ? mix * guide_.field->pdf(guide.region, wi) + (1.f - mix) * phase : phase;
 }
 
 PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
@@ -356,9 +343,7 @@ Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float 
     if (isBlack(tr)) return Spectrum(0.f);
     if (ls.isDelta) return phase * tr * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
-    float w = powerHeuristic(1, lightPdf, 1,
-                             guide.region >= 0 ? mediumDirectionPdf(phase, guide, ls.wi)
-                                               : phase);
+    float w = powerHeuristic(1, lightPdf, 1, mixturePdf(guide, ls.wi, phase));
     return phase * tr * ls.L * (w / lightPdf);
 }
 

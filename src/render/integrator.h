@@ -1,6 +1,6 @@
 // The one path-tracing integrator (pbrt-v3 `path` semantics: maxdepth, Russian roulette after
 // bounce 3, next-event estimation with power-heuristic MIS). The direction-sampling step is a
-// seam (sampleDirection / directionPdf) where a guiding backend plugs in later.
+// seam (sampleDirection / mixturePdf) where a guiding backend plugs in.
 #pragma once
 
 #include <cstdint>
@@ -150,11 +150,22 @@ private:
     };
     float guideMix(VertexGuide& g) const {
         if (g.mix < 0.f) {
-            g.confidence = g.region >= 0 ? guide_.field->confidence(g.region) : 0.f;
-            g.scale = g.region >= 0 ? g.confidence * g.share : 0.f;
-            g.mix = g.region >= 0 ? regionSelection(g.region) * g.scale : 0.f;
+            g.mix = 0.f;
+            if (g.region >= 0) {
+                g.confidence = guide_.field->confidence(g.region);
+                g.scale = g.confidence * g.share;
+                g.mix = regionSelection(g.region) * g.scale;
+            }
         }
         return g.mix;
+    }
+    // The pdf of a vertex's direction sampling for wi: the guide mixed with the BSDF or phase
+    // function, whose pdf of wi is otherPdf (otherPdf alone without a guided share).
+    float mixturePdf(VertexGuide& g, const Vec3& wi, float otherPdf) const {
+        if (g.region < 0) return otherPdf;
+        const float mix = guideMix(g);
+        return mix > 0.f ? mix * guide_.field->pdf(g.region, wi) + (1.f - mix) * otherPdf
+                         : otherPdf;
     }
     float guideConfidence(VertexGuide& g) const {
         guideMix(g);
@@ -162,8 +173,6 @@ private:
     }
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
                                     VertexGuide& guide, Sampler& sampler) const;
-    float directionPdf(const BSDF& bsdf, VertexGuide& guide, const Vec3& wo,
-                       const Vec3& wi) const;
     // The selection probability of a region: learned (mix=learn, where the field has one) or
     // the mix setting.
     float regionSelection(int region) const {
@@ -187,11 +196,9 @@ private:
                                const PathMedium& pm, Sampler& sampler, PathStats& stats) const;
     // The direction-sampling seam at a medium vertex: the phase function, or at a region the
     // guide with probability guideMix, mixed with it (f = the phase value; one 1D dimension
-    // more when a field is set). And the pdf of that strategy for wi, whose phase value is
-    // `phase`.
+    // more when a field is set); mixturePdf gives that strategy's pdf.
     DirectionSample sampleMediumDirection(const Vec3& wo, float g, VertexGuide& guide,
                                           Sampler& sampler) const;
-    float mediumDirectionPdf(float phase, VertexGuide& guide, const Vec3& wi) const;
     // Transmittance of the segment o + t d, t in (0, tMax), starting in `medium`: through
     // medium boundaries (interface-only surfaces), zero at any other surface.
     Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
