@@ -27,6 +27,12 @@ void GuidingField::recordSelection(int, int, const SelectionSample&) {}
 
 int GuidingField::lookupMedium(const glm::vec3&) const { return -1; }
 void GuidingField::prefetch(const glm::vec3&) const {}
+float GuidingField::patchSize() const { return 0.f; }
+void GuidingField::setPatches(uint32_t, std::function<bool(uint32_t, glm::vec3*, glm::vec3*)>) {}
+int GuidingField::lookupPatch(uint32_t, const glm::vec3& p, const glm::vec3& n) const {
+    return lookup(p, n);
+}
+void GuidingField::prefetchPatch(uint32_t, const glm::vec3& p) const { prefetch(p); }
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
 
@@ -174,9 +180,10 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
                 return badValue("hemi", key, value, "a number in [0, 1e9]", error);
             hp->warmup = d;
         } else if (key == "lookup") {
-            if (value != "cell" && value != "exact")
-                return badValue("hemi", key, value, "cell or exact", error);
-            hp->cellLookup = value == "cell";
+            if (value != "patch" && value != "cell" && value != "exact")
+                return badValue("hemi", key, value, "patch, cell or exact", error);
+            hp->cellLookup = value != "exact";
+            hp->patchLookup = value == "patch";
         } else {
             *error = "guiding backend 'hemi': unknown parameter '" + key +
                      "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "

@@ -79,6 +79,24 @@ public:
     // A hint that lookup(p, ...) follows soon: a backend may start loading what it will read
     // (no effect on results). Default: nothing.
     virtual void prefetch(const glm::vec3& p) const;
+    // Surface patches (optional): the integrator may cut the scene's surfaces into small
+    // pieces named by keys in [0, count) (render/patches.h) and pass each vertex's key to
+    // lookupPatch, which a backend may answer from a memo per piece instead of a spatial
+    // search. patchSize(): the piece size the backend wants, in world units (0, the default:
+    // it uses none). setPatches(count, centre): centre(i, &p, &n) gives a point of piece i
+    // and its unit normal (either orientation; false or a zero normal: unknown); called before
+    // rendering, and centre must stay valid and thread-safe for the field's life. Default:
+    // ignored.
+    static constexpr uint32_t kNoPatch = UINT32_MAX;
+    virtual float patchSize() const;
+    virtual void setPatches(uint32_t count,
+                            std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> centre);
+    // lookup(p, n) for a vertex on piece `patch` (kNoPatch, or no patches: lookup(p, n)
+    // itself). A backend may return the region of the piece's centre and normal where that
+    // region is admissible for n. Default: lookup(p, n).
+    virtual int lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const;
+    // prefetch() for a lookupPatch(patch, p, ...) that follows soon. Default: prefetch(p).
+    virtual void prefetchPatch(uint32_t patch, const glm::vec3& p) const;
     // Region for a scattering vertex at p inside a participating medium, whose directions
     // cover the whole sphere; -1 = no data there (sample the phase function). All the
     // per-region calls below accept it. Default: -1 (the backend guides on surfaces only).
@@ -178,9 +196,12 @@ public:
 //   init         initial Q, positive and <= 3.4e38 (default 1e-3)
 //   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)
 //   knn          nearest points checked for an admissible normal, 1..64 (default 8)
-//   lookup       "cell" (default): the knn points nearest to the centre of the vertex's grid
-//                cell (cells of the points' mean spacing), memoised per cell; "exact": the
-//                knn points nearest to the vertex (kd-tree query per vertex)
+//   lookup       "patch" (default): the knn points nearest to the centre of the vertex's
+//                surface patch (setPatches; pieces of the points' mean spacing), memoised per
+//                patch, and "cell" where the vertex has no patch or that point is not
+//                admissible; "cell": the knn points nearest to the centre of the vertex's
+//                grid cell (cells of the points' mean spacing), memoised per cell; "exact":
+//                the knn points nearest to the vertex (kd-tree query per vertex)
 //   warmup       records per stratum until a region's policy gets the full mixture weight:
 //                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 8;
 //                0 = always full weight, the paper's behaviour)

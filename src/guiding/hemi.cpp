@@ -72,6 +72,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         // per point leave the table at most three quarters full on usual scenes.
         const double spacing =
             std::sqrt(std::max(scene.totalArea, 0.0) / double(positions_.size()));
+        spacing_ = float(spacing);
         cache_ = std::make_unique<CellCache>(scene.boundsMin, scene.boundsMax, float(spacing),
                                              positions_.size() * 8);
     }
@@ -133,6 +134,56 @@ int HemiField::lookup(const glm::vec3& p, const glm::vec3& n) const {
             return prefetched(int(candidates[i]) * 2 + (c >= 0.f ? 0 : 1));
     }
     return -1;
+}
+
+float HemiField::patchSize() const {
+    return params_.patchLookup && cache_ && std::isfinite(spacing_) ? spacing_ : 0.f;
+}
+
+void HemiField::setPatches(uint32_t count,
+                           std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> centre) {
+    patchPoint_.reset();
+    numPatches_ = 0;
+    patchCentre_ = nullptr;
+    if (!(patchSize() > 0.f) || count == 0 || !centre) return;
+    patchPoint_.reset(static_cast<uint32_t*>(std::calloc(count, sizeof(uint32_t))));
+    if (!patchPoint_) return;  // out of memory: the cell lookup serves every vertex
+    numPatches_ = count;
+    patchCentre_ = std::move(centre);
+}
+
+uint32_t HemiField::fillPatch(uint32_t patch) const {
+    glm::vec3 c(0.f), n(0.f);
+    if (!patchCentre_(patch, &c, &n) || !finite3(c)) return kNoPoint;
+    const float len = glm::length(n);
+    if (!(len > 0.f) || !std::isfinite(len)) return kNoPoint;
+    n /= len;
+    uint32_t idx[PointKdTree::kMaxK];
+    float dist2[PointKdTree::kMaxK];
+    const int found = tree_->knn(c, params_.knn, idx, dist2);
+    for (int i = 0; i < found; ++i)
+        if (std::abs(glm::dot(n, normals_[idx[i]])) >= cosMaxAngle_) return idx[i] + 1;
+    return kNoPoint;
+}
+
+int HemiField::lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const {
+    if (patch < numPatches_) {
+        uint32_t v = __atomic_load_n(&patchPoint_[patch], __ATOMIC_RELAXED);
+        if (v == 0) {
+            v = fillPatch(patch);
+            __atomic_store_n(&patchPoint_[patch], v, __ATOMIC_RELAXED);
+        }
+        if (v != kNoPoint) {
+            // The patch's point, if admissible for n as well (a shading normal may lean
+            // further than the patch's): of its two hemispheres, the one on n's side.
+            const uint32_t point = v - 1;
+            const float nLen = glm::length(n);
+            const float c = glm::dot(n, normals_[point]);
+            if (nLen > 0.f && std::isfinite(nLen) && std::abs(c) >= cosMaxAngle_ * nLen)
+                return prefetched(int(point) * 2 + (c >= 0.f ? 0 : 1));
+        }
+    }
+    return lookup(p, n);
 }
 
 int HemiField::prefetched(int region) const {
@@ -295,7 +346,7 @@ void HemiField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlp
 size_t HemiField::bytes() const {
     return table_.bytes() + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
            frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +
-           (cache_ ? cache_->bytes() : 0);
+           (cache_ ? cache_->bytes() : 0) + size_t(numPatches_) * sizeof(uint32_t);
 }
 
 size_t HemiField::scratchBytes() const { return table_.scratchBytes(); }
@@ -326,6 +377,10 @@ std::string HemiField::describe() const {
     if (cache_) {
         std::snprintf(buf, sizeof(buf), "; lookup memo: %zu of %zu cells filled",
                       cache_->size(), cache_->capacity());
+        line += buf;
+    }
+    if (numPatches_ > 0) {
+        std::snprintf(buf, sizeof(buf), "; %u surface patches", numPatches_);
         line += buf;
     }
     const SelectionLearner& sel = table_.selection();

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +67,13 @@ struct HemiParams {
     // (64 spp relMSE, seeds 2/3: veach-bidir 0.168/0.176 -> 0.165/0.159, breakfast 5.73/5.08
     // -> 5.27/4.49, buddha-fractal, killeroo, cornell-box within 1.5%).
     bool cellLookup = true;
+    // lookup=patch (the default): where the integrator names the vertex's surface patch
+    // (setPatches: pieces about as large as the cells), the knn points nearest to the patch's
+    // centre, memoised per patch, are checked against the patch's normal once; the first
+    // admissible one answers the vertex if it is admissible for the vertex's normal too (else,
+    // and off patches, the cell memo). A patch's memo is one word, found from the hit without
+    // hashing or probing (docs/BENCHMARKS.md, session 17).
+    bool patchLookup = true;
     // The integrator's target (the "target" parameter, which it validates): "path" (the
     // default) reads no estimates per vertex; "sample" and "sum" read them for Eq. 1's
     // bootstrap, so that the lookup prefetches them as well.
@@ -99,6 +108,17 @@ public:
     void prefetch(const glm::vec3& p) const override {
         if (cache_ && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
             cache_->prefetch(p);
+    }
+    float patchSize() const override;
+    void setPatches(uint32_t count,
+                    std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> centre) override;
+    int lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const override;
+    void prefetchPatch(uint32_t patch, const glm::vec3& p) const override {
+        if (patch < numPatches_) {
+            prefetchLine(&patchPoint_[patch]);
+        } else {
+            prefetch(p);
+        }
     }
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
                      int* bin = nullptr) const override;
@@ -138,6 +158,14 @@ public:
     const HemiParams& params() const { return params_; }
     // The lookup's cell memo (null with lookup=exact, or knn > CellCache::kMaxCandidates).
     const CellCache* cellCache() const { return cache_.get(); }
+    // Patches set by setPatches (0 without), and the point a patch's memo holds (-1: none
+    // admissible or not filled yet).
+    uint32_t numPatches() const { return numPatches_; }
+    int patchPoint(uint32_t patch) const {
+        if (patch >= numPatches_) return -1;
+        const uint32_t v = __atomic_load_n(&patchPoint_[patch], __ATOMIC_RELAXED);
+        return v == 0 || v == kNoPoint ? -1 : int(v - 1);
+    }
     // Surface position and unit hemisphere normal of a region.
     glm::vec3 regionPosition(int region) const { return positions_[size_t(region) / 2]; }
     glm::vec3 regionNormal(int region) const {
@@ -196,6 +224,20 @@ private:
     int numRegions_ = 0;                // 2 x the points (validRegion on every query)
     std::unique_ptr<PointKdTree> tree_;
     std::unique_ptr<CellCache> cache_;  // lookup=cell only
+    // lookup=patch: per patch 0 (not yet filled), point + 1, or kNoPoint (no admissible
+    // point), read and written with relaxed atomics (a fill is a pure function of the patch,
+    // so racing fills agree); zeroed pages from calloc, so a large table of patches that no
+    // path reaches costs address space only.
+    static constexpr uint32_t kNoPoint = UINT32_MAX;
+    struct FreeDeleter {
+        void operator()(void* p) const { std::free(p); }
+    };
+    std::unique_ptr<uint32_t[], FreeDeleter> patchPoint_;
+    uint32_t numPatches_ = 0;
+    std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> patchCentre_;
+    float spacing_ = 0.f;  // the points' mean spacing: cells' and patches' size
+    // The memo entry of a patch (kNoPoint if none admissible).
+    uint32_t fillPatch(uint32_t patch) const;
     // Per region, one cache line: the frame of its hemisphere (z = normal), the moment
     // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, its confidence, and the scale
     // that turns a stratum's probability back into its Q (policyRadiance).

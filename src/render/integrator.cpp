@@ -135,6 +135,20 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     *field = guiding::createGuidingField(config, info, error);
     if (!*field) return false;
     settings->field = field->get();
+    const float patchSize = (*field)->patchSize();
+    if (patchSize > 0.f) {
+        // At most 2^24 patches (64 MiB of memo at most, in pages touched only where paths
+        // go); a scene with more triangles than that gets none (the cell lookup serves it).
+        auto patches = std::make_shared<const SurfacePatches>(scene.worldPrimitives(), patchSize,
+                                                              uint64_t(1) << 24);
+        if (patches->count() > 0) {
+            settings->patches = patches;
+            (*field)->setPatches(patches->count(),
+                                 [patches](uint32_t i, glm::vec3* p, glm::vec3* n) {
+                                     return patches->centre(i, p, n);
+                                 });
+        }
+    }
     return true;
 }
 
@@ -447,7 +461,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const bool wantsRegion = field && (!lastDirection || bootstrap);
         // The lookup below reads a table entry for si.p: start loading it (a cache miss
         // otherwise; the material evaluation runs in between).
-        if (found && wantsRegion) field->prefetch(si.p);
+        uint32_t patch = SurfacePatches::kNone;
+        if (found && wantsRegion) {
+            if (guide_.patches) patch = guide_.patches->key(si);
+            field->prefetchPatch(patch, si.p);
+        }
         if (media && pm.medium >= 0) {
             // Free flight to the surface (or to infinity) through the current medium.
             const Medium& medium = *scene_.media[size_t(pm.medium)];
@@ -554,7 +572,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         int region = -1;
         if (canGuide && wantsRegion) {
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
-            region = field->lookup(si.p, nFacing);
+            region = field->lookupPatch(patch, si.p, nFacing);
         }
         const bool lastVertex = bounces >= maxDepth_;
         // The guide's probability here: mix x the region's confidence x the diffuse share.

@@ -8,6 +8,7 @@
 
 #include "guiding/guiding.h"
 #include "render/light_sampler.h"
+#include "render/patches.h"
 #include "render/ray.h"
 #include "render/scene.h"
 
@@ -32,6 +33,9 @@ struct PathStats {
 // How the integrator uses a guiding field (none when field is null).
 struct GuideSettings {
     guiding::GuidingField* field = nullptr;
+    // The surface patches the field asked for (GuidingField::patchSize), whose keys the
+    // integrator passes to lookupPatch; null if it wants none or the scene has no triangles.
+    std::shared_ptr<const SurfacePatches> patches;
     // Probability of sampling a direction from the guide at a vertex that has guiding data
     // (one-sample MIS mixture with BSDF sampling): 0 = BSDF only, 1 = the paper's pure policy.
     float mix = 0.5f;

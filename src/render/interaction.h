@@ -17,7 +17,9 @@ struct SurfaceInteraction {
     Vec3 shadingTangent{0.f};   // optional per-vertex tangent (mesh "S"), else zero
     int material = -1;  // index into Scene::materials; -1 = interface only (no surface)
     int light = -1;     // index into Scene::lights when the surface emits
-    int primitive = -1; // index of the shape record (for statistics and debugging)
+    int primitive = -1; // world hits: the shape record (Embree geomID); -1 for instances
+    unsigned primID = 0;  // world hits: the triangle (or quadric) within it
+    Vec2 bary{0.f};       // world hits: Embree's hit coordinates (triangles: b1, b2)
     // Media on the two sides (indices into Scene::media, -1 = none); a boundary when they
     // differ: a ray leaving along w enters mediumOutside if dot(w, ng) > 0, else mediumInside.
     int mediumInside = -1, mediumOutside = -1;

@@ -121,8 +121,15 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
         const Primitive& prim = groups_[0].prims[rh.hit.geomID];
         hitDetails(prim, rh.hit.primID, rh.hit.u, rh.hit.v, ray, rh.ray.tfar, nullptr, si);
         si->primitive = int(rh.hit.geomID);
+        si->primID = rh.hit.primID;
+        si->bary = Vec2(rh.hit.u, rh.hit.v);
     }
     return true;
+}
+
+const std::vector<Primitive>& Scene::worldPrimitives() const {
+    static const std::vector<Primitive> kNone;
+    return groups_.empty() ? kNone : groups_[0].prims;
 }
 
 bool Scene::occluded(const Vec3& o, const Vec3& d, float tMax) const {

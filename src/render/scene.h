@@ -87,6 +87,9 @@ public:
     bool sampleSurface(const Vec3& u, Vec3* p, Vec3* n) const;
     double totalSurfaceArea() const;
 
+    // The world's primitives, indexed by SurfaceInteraction::primitive (SurfacePatches).
+    const std::vector<Primitive>& worldPrimitives() const;
+
     Vec3 boundsMin() const { return bMin_; }
     Vec3 boundsMax() const { return bMax_; }
 

@@ -303,6 +303,84 @@ TEST(HemiField, CellLookupTakesTheFirstAdmissibleNearTheCellCentre) {
     }
 }
 
+// lookup=patch: a patch answers with the first of the knn points nearest to its centre whose
+// normal is within the admissible angle of the patch's normal (memoised per patch), on the
+// query normal's side, when that point is admissible for the query normal too; otherwise,
+// and for kNoPatch or keys past the patches, the cell lookup answers. Here the patches are a
+// 10x10 grid over the corner's floor and another over its wall.
+TEST(HemiField, PatchLookupTakesThePatchCentresAdmissiblePoint) {
+    auto f = makeHemi(cornerScene(), {{"points", "2000"}});
+    ASSERT_TRUE(f);
+    EXPECT_NEAR(f->patchSize(), std::sqrt(2.0 / 2000.0), 1e-6);
+    auto centreOf = [](uint32_t i, glm::vec3* p, glm::vec3* n) {
+        if (i >= 200) return false;
+        const float a = (float(i % 100 / 10) + 0.5f) / 10.f, b = (float(i % 10) + 0.5f) / 10.f;
+        *p = i < 100 ? glm::vec3(a, b, 0.f) : glm::vec3(0.f, b, a);
+        // The floor's normal given downwards: the orientation must not matter.
+        *n = i < 100 ? glm::vec3(0.f, 0.f, -1.f) : glm::vec3(1.f, 0.f, 0.f);
+        return true;
+    };
+    f->setPatches(200, centreOf);
+    ASSERT_EQ(f->numPatches(), 200u);
+    const float cosMax = std::cos(30.f * 3.14159265f / 180.f);
+    std::mt19937_64 rng(29);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    int viaPatch = 0, viaCell = 0;
+    for (int q = 0; q < 800; ++q) {
+        const uint32_t patch = uint32_t(q % 200);
+        glm::vec3 c, pn;
+        ASSERT_TRUE(centreOf(patch, &c, &pn));
+        // A query on the patch, with a normal near the patch's (either side) or anywhere.
+        glm::vec3 p = c + glm::vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, uni(rng) - 0.5f) * 0.05f;
+        glm::vec3 n = q % 4 == 3 ? gaussianDirection(rng)
+                                 : glm::normalize((q % 2 ? -pn : pn) + 0.3f * gaussianDirection(rng));
+        const int point = firstAdmissibleNear(*f, c, pn, 8);  // region on pn's side
+        int expected = -1;
+        if (point >= 0) {
+            const float cq = glm::dot(n, f->regionNormal(point & ~1));
+            if (std::abs(cq) >= cosMax) expected = (point & ~1) + (cq >= 0.f ? 0 : 1);
+        }
+        const int cell = f->lookup(p, n);
+        if (expected >= 0) {
+            ++viaPatch;
+        } else {
+            expected = cell;
+            ++viaCell;
+        }
+        EXPECT_EQ(f->lookupPatch(patch, p, n), expected) << "query " << q;
+        EXPECT_EQ(f->lookupPatch(patch, p, n), expected) << "query " << q << " again";
+        EXPECT_EQ(f->patchPoint(patch), point < 0 ? -1 : point / 2) << "query " << q;
+        EXPECT_EQ(f->lookupPatch(GuidingField::kNoPatch, p, n), cell);
+        EXPECT_EQ(f->lookupPatch(200, p, n), cell);
+    }
+    EXPECT_GT(viaPatch, 400);
+    EXPECT_GT(viaCell, 50);
+    // Other lookups want no patches.
+    EXPECT_EQ(makeHemi(cornerScene(), {{"lookup", "cell"}})->patchSize(), 0.f);
+    EXPECT_EQ(makeHemi(cornerScene(), {{"lookup", "exact"}})->patchSize(), 0.f);
+    auto cellOnly = makeHemi(cornerScene(), {{"lookup", "cell"}});
+    cellOnly->setPatches(200, centreOf);
+    EXPECT_EQ(cellOnly->numPatches(), 0u);
+}
+
+// A patch whose centre function fails, or gives no usable normal, has no point: the cell
+// lookup answers for it.
+TEST(HemiField, PatchWithoutCentreFallsBackToTheCellLookup) {
+    auto f = makeHemi(cornerScene(), {{"points", "500"}});
+    ASSERT_TRUE(f);
+    f->setPatches(3, [](uint32_t i, glm::vec3* p, glm::vec3* n) {
+        *p = glm::vec3(0.5f, 0.5f, 0.f);
+        *n = i == 1 ? glm::vec3(0.f) : glm::vec3(std::nanf(""), 0.f, 1.f);
+        return i != 0;
+    });
+    const glm::vec3 p(0.5f, 0.5f, 0.f), n(0.f, 0.f, 1.f);
+    for (uint32_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(f->lookupPatch(i, p, n), f->lookup(p, n));
+        EXPECT_EQ(f->patchPoint(i), -1);
+    }
+    EXPECT_GE(f->lookup(p, n), 0);
+}
+
 TEST(HemiField, LookupNearCornerPicksFloorOrWallByNormal) {
     auto f = makeHemi(cornerScene(), {{"points", "4000"}});
     ASSERT_TRUE(f);
