@@ -25,12 +25,12 @@ uint32_t cutsFor(float edge, double size) {
 SurfacePatches::SurfacePatches(const std::vector<Primitive>& prims, float size,
                                uint64_t maxPatches)
     : prims_(&prims) {
-    geomFirst_.assign(prims.size(), kNone);
+    geoms_.assign(prims.size(), Geom());
     uint64_t triangles = 0;
     for (const Primitive& prim : prims)
         if (prim.shape.mesh) triangles += prim.shape.mesh->triangleCount();
-    // One patch per triangle at least, and keys below kNone.
-    if (triangles == 0 || triangles > maxPatches || triangles >= uint64_t(kNone)) return;
+    // One patch per triangle at least, and keys below kWhole.
+    if (triangles == 0 || triangles > maxPatches || triangles >= uint64_t(kWhole)) return;
     std::vector<float> edges;
     edges.reserve(size_t(triangles));
     for (const Primitive& prim : prims)
@@ -44,7 +44,7 @@ SurfacePatches::SurfacePatches(const std::vector<Primitive>& prims, float size,
             const uint64_t k = cutsFor(e, s);
             total += k * k;
         }
-        if (total <= maxPatches && total < uint64_t(kNone)) break;
+        if (total <= maxPatches && total < uint64_t(kWhole)) break;
         if (attempt >= 60) {
             s = 0.0;  // every triangle one patch (fits: triangles <= maxPatches)
             break;
@@ -52,16 +52,24 @@ SurfacePatches::SurfacePatches(const std::vector<Primitive>& prims, float size,
         s *= std::max(1.1, std::sqrt(double(total) / double(maxPatches)));
     }
     size_ = float(s);
-    tris_.reserve(size_t(triangles));
     uint32_t next = 0;
     size_t e = 0;
     for (size_t g = 0; g < prims.size(); ++g) {
         const TriangleMesh* m = prims[g].shape.mesh.get();
         if (!m || m->triangleCount() == 0) continue;
-        geomFirst_[g] = uint32_t(tris_.size());
-        triGeom_.push_back(uint32_t(tris_.size()));
-        triGeomId_.push_back(uint32_t(g));
-        for (size_t t = 0; t < m->triangleCount(); ++t) {
+        const size_t n = m->triangleCount();
+        geoms_[g].firstPatch = next;
+        patchedGeoms_.push_back(uint32_t(g));
+        bool whole = true;
+        for (size_t t = 0; t < n && whole; ++t) whole = cutsFor(edges[e + t], s) == 1;
+        if (whole) {
+            geoms_[g].firstTri = kWhole;
+            next += uint32_t(n);
+            e += n;
+            continue;
+        }
+        geoms_[g].firstTri = uint32_t(tris_.size());
+        for (size_t t = 0; t < n; ++t) {
             const uint32_t k = cutsFor(edges[e++], s);
             tris_.push_back(Tri{next, k});
             next += k * k;
@@ -72,18 +80,28 @@ SurfacePatches::SurfacePatches(const std::vector<Primitive>& prims, float size,
 
 bool SurfacePatches::centre(uint32_t patch, Vec3* p, Vec3* n) const {
     if (patch >= count_) return false;
-    // The triangle: the last whose first patch is <= patch; its primitive likewise.
-    const auto tri = std::upper_bound(tris_.begin(), tris_.end(), patch,
-                                      [](uint32_t v, const Tri& t) { return v < t.first; }) -
-                     1;
-    const size_t ti = size_t(tri - tris_.begin());
-    const size_t gi =
-        size_t(std::upper_bound(triGeom_.begin(), triGeom_.end(), uint32_t(ti)) -
-               triGeom_.begin()) -
-        1;
-    const TriangleMesh& m = *(*prims_)[triGeomId_[gi]].shape.mesh;
-    const size_t local = ti - triGeom_[gi];
-    const uint32_t k = tri->cuts, cell = patch - tri->first;
+    // The primitive: the last whose first patch is <= patch; then its triangle likewise.
+    const uint32_t g = *(std::upper_bound(patchedGeoms_.begin(), patchedGeoms_.end(), patch,
+                                          [this](uint32_t v, uint32_t geom) {
+                                              return v < geoms_[geom].firstPatch;
+                                          }) -
+                         1);
+    const Geom& geom = geoms_[g];
+    const TriangleMesh& m = *(*prims_)[g].shape.mesh;
+    size_t local = 0;
+    uint32_t k = 1, cell = 0;
+    if (geom.firstTri == kWhole) {
+        local = patch - geom.firstPatch;
+    } else {
+        const auto first = tris_.begin() + geom.firstTri;
+        const auto tri = std::upper_bound(first, first + std::ptrdiff_t(m.triangleCount()),
+                                          patch,
+                                          [](uint32_t v, const Tri& t) { return v < t.first; }) -
+                         1;
+        local = size_t(tri - first);
+        k = tri->cuts;
+        cell = patch - tri->first;
+    }
     const float a = float(cell / k), b = float(cell % k), kf = float(k);
     // The cell's centre in the barycentric square; in a cell the far edge cuts, its lower
     // triangle's centroid; past the edge (never hit), the edge point in its direction.

@@ -33,10 +33,12 @@ public:
     uint32_t count() const { return count_; }
     // The patch of a hit (si.primitive, si.primID, si.bary), or kNone.
     uint32_t key(const SurfaceInteraction& si) const {
-        if (si.primitive < 0 || size_t(si.primitive) >= geomFirst_.size()) return kNone;
-        const uint32_t first = geomFirst_[size_t(si.primitive)];
-        if (first == kNone) return kNone;
-        const Tri& t = tris_[size_t(first) + si.primID];
+        if (si.primitive < 0 || size_t(si.primitive) >= geoms_.size()) return kNone;
+        const Geom& g = geoms_[size_t(si.primitive)];
+        // A mesh of small triangles: one patch each, numbered as its triangles.
+        if (g.firstTri == kWhole) return g.firstPatch + si.primID;
+        if (g.firstTri == kNone) return kNone;
+        const Tri& t = tris_[size_t(g.firstTri) + si.primID];
         const float k = float(t.cuts);
         const uint32_t last = t.cuts - 1;
         // Truncation is the floor for the non-negative barycentrics (NaN -> 0 on x86; clamped).
@@ -52,20 +54,26 @@ public:
     float size() const { return size_; }
     // Bytes of the tables.
     size_t bytes() const {
-        return geomFirst_.capacity() * sizeof(uint32_t) + tris_.capacity() * sizeof(Tri) +
-               (triGeom_.capacity() + triGeomId_.capacity()) * sizeof(uint32_t);
+        return geoms_.capacity() * sizeof(Geom) + tris_.capacity() * sizeof(Tri) +
+               patchedGeoms_.capacity() * sizeof(uint32_t);
     }
 
 private:
+    static constexpr uint32_t kWhole = UINT32_MAX - 1;  // Geom::firstTri: one patch per triangle
     struct Tri {
         uint32_t first;  // its first patch
         uint32_t cuts;   // k: k^2 patches
     };
+    // Per primitive: its first patch, and the index of its first triangle in tris_, or kWhole
+    // (every triangle one patch: no per-triangle entries), or kNone (no patches).
+    struct Geom {
+        uint32_t firstPatch = 0;
+        uint32_t firstTri = kNone;
+    };
     const std::vector<Primitive>* prims_;
-    std::vector<uint32_t> geomFirst_;  // per primitive: index of its first triangle in tris_
-    std::vector<Tri> tris_;            // all patched triangles, in primitive order
-    std::vector<uint32_t> triGeom_;    // per primitive with triangles: its first tris_ index
-    std::vector<uint32_t> triGeomId_;  // ... and its geomID (parallel to triGeom_)
+    std::vector<Geom> geoms_;
+    std::vector<Tri> tris_;             // triangles of the primitives that cut some of theirs
+    std::vector<uint32_t> patchedGeoms_;  // primitives with patches, in patch order
     uint32_t count_ = 0;
     float size_ = 0.f;
 };

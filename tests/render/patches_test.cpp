@@ -22,7 +22,8 @@ namespace rlpbrt {
 namespace {
 
 // A 2 x 2 quad at z = 0 (two triangles with edges 2, 2 and 2.83), a small triangle at z = 1
-// (edges 0.1, 0.1, 0.14) and a sphere away from both.
+// (edges 0.1, 0.1, 0.14), a sphere away from both, and a mesh of one triangle as large as the
+// quad's and one as small (x in [4, 6]).
 const char* kScene = R"(
 Film "image" "integer xresolution" [8] "integer yresolution" [8]
 Sampler "random" "integer pixelsamples" [1]
@@ -38,6 +39,8 @@ AttributeBegin
   Translate -5 -5 0
   Shape "sphere" "float radius" [1]
 AttributeEnd
+Shape "trianglemesh" "point P" [4 -1 0  6 -1 0  6 1 0  5 1.5 0  5.1 1.5 0  5 1.6 0]
+  "integer indices" [0 1 2  3 4 5]
 WorldEnd
 )";
 
@@ -62,9 +65,9 @@ TEST(SurfacePatches, CutsPerTriangleFromTheLongestEdge) {
     auto scene = buildTestScene();
     ASSERT_TRUE(scene);
     // Size 0.25: the quad's triangles ceil(2.83 / 0.25) = 12 cuts (144 patches each), the small
-    // triangle one patch.
+    // triangle one patch, the last mesh 144 + 1.
     SurfacePatches patches(scene->worldPrimitives(), 0.25f, 1u << 20);
-    EXPECT_EQ(patches.count(), 2u * 144u + 1u);
+    EXPECT_EQ(patches.count(), 2u * 144u + 1u + 144u + 1u);
     EXPECT_EQ(patches.size(), 0.25f);
     // A budget below that grows the size until the patches fit.
     SurfacePatches tight(scene->worldPrimitives(), 0.25f, 100);
@@ -76,7 +79,7 @@ TEST(SurfacePatches, CutsPerTriangleFromTheLongestEdge) {
     EXPECT_EQ(none.count(), 0u);
     // A size that is not positive: one patch per triangle.
     SurfacePatches whole(scene->worldPrimitives(), 0.f, 1u << 20);
-    EXPECT_EQ(whole.count(), 3u);
+    EXPECT_EQ(whole.count(), 5u);
     // Every key of a hit is in range and kNone elsewhere.
     SurfaceInteraction si;
     ASSERT_TRUE(hitDown(*scene, -5.f, -5.f, 3.f, &si));  // the sphere
@@ -103,8 +106,8 @@ TEST(SurfacePatches, KeysOfHitsMatchThePatchCentres) {
         Vec3 c, n;
         ASSERT_TRUE(patches.centre(i, &c, &n));
         EXPECT_NEAR(std::abs(n.z), 1.f, 1e-6f) << i;
-        EXPECT_EQ(c.z, i < 288 ? 0.f : 1.f) << i;
-        if (!inside.count(i)) continue;
+        EXPECT_EQ(c.z, i == 288 ? 1.f : 0.f) << i;
+        if (!inside.count(i)) continue;  // (the quad's cells past the far edge, the others)
         SurfaceInteraction si;
         ASSERT_TRUE(hitDown(*scene, c.x, c.y, 2.f, &si)) << i;
         EXPECT_EQ(patches.key(si), i);
@@ -125,6 +128,15 @@ TEST(SurfacePatches, KeysOfHitsMatchThePatchCentres) {
     }
     reached.erase(288);  // the small triangle, missed by these rays
     EXPECT_EQ(reached, inside);
+    // The mixed mesh: its large triangle's cell (0, 0) is patch 289, its small triangle 433.
+    for (uint32_t i : {289u, 300u, 433u}) {
+        Vec3 c, n;
+        ASSERT_TRUE(patches.centre(i, &c, &n));
+        EXPECT_GT(c.x, 4.f);
+        SurfaceInteraction si;
+        ASSERT_TRUE(hitDown(*scene, c.x, c.y, 1.f, &si)) << i;
+        EXPECT_EQ(patches.key(si), i);
+    }
     SurfaceInteraction si;
     ASSERT_TRUE(hitDown(*scene, 3.02f, 3.02f, 2.f, &si));
     const uint32_t key = patches.key(si);
