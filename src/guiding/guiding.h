@@ -191,7 +191,7 @@ public:
 //   strata       "WxH" (default 16x16): W columns in phi, H rows in
 //                cos(theta), each 1..64;
 //                "N" means NxN
-//   points       surface samples, 1..2^26 (default 2048); each gives two hemispheres (n, -n)
+//   points       surface samples, 1..2^26 (default 1024); each gives two hemispheres (n, -n)
 //   normal-angle admissible normal deviation in degrees, (0, 180) (default 30)
 //   init         initial Q, positive and <= 3.4e38 (default 1e-3)
 //   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)
@@ -224,7 +224,7 @@ public:
 //   voxel-size   the voxel edge in world units, > 0 (not with voxel)
 //                (default for both: the edge that gives about 1024 voxels' worth of surface,
 //                sqrt(totalArea / 1024), clamped to [longest / 1024, longest / 4]; fewer
-//                regions learn faster, as hemi's 2048 points: 64 spp relMSE, seeds 2/3,
+//                regions learn faster, as hemi's points: 64 spp relMSE, seeds 2/3,
 //                veach-bidir 0.237/0.259 -> 0.193/0.223, breakfast 5.59/5.92 -> 5.62/4.48,
 //                killeroo 0.00051/0.00051 -> 0.00049/0.00050, buddha-fractal equal)
 //   points       surface samples that activate voxels, 1..2^26 (default: 16 per voxel's

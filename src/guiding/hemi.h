@@ -38,8 +38,14 @@ struct HemiParams {
     // (64 spp, seeds 2/3/4) veach-bidir 0.255/0.307/0.279 with 8192 points against
     // 0.185/0.195/0.191 with 2048 (and 0.0644 against 0.0475 at 256 spp), breakfast
     // 6.92/6.28 against 5.28/5.66, killeroo 0.00053/0.00052 against 0.00051/0.00050,
-    // buddha-fractal 0.0225/0.0232 against 0.0226/0.0231 (docs/BENCHMARKS.md).
-    uint64_t points = 2048;
+    // buddha-fractal 0.0225/0.0232 against 0.0226/0.0231 (docs/BENCHMARKS.md). 1024 since
+    // the patch lookup (session 17): the cell memo had left many points without a cell
+    // (veach-bidir: 1161 regions learned of 2048 points' 4096), and with every point in use
+    // 2048 points learned slower (veach-bidir 64 spp, seeds 2-5: cell 0.142/0.141/0.139/0.129,
+    // patches with 2048 points 0.154/0.163/0.147/0.141, with 1024 0.137/0.143/0.144/0.131).
+    // At 30 s against none (docs/BENCHMARKS.md) 1024 matches or beats 2048 on every scene,
+    // with half the tables.
+    uint64_t points = 1024;
     double normalAngleDeg = 30;  // admissible normal deviation
     double init = 1e-3;          // initial Q
     double epsilon = 0.1;        // uniform share of every CDF

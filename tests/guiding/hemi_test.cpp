@@ -163,8 +163,9 @@ TEST(GuidingFactory, NoneAndErrors) {
 TEST(HemiField, DefaultsAndMemory) {
     auto f = makeHemi(planeScene());
     ASSERT_TRUE(f);
-    EXPECT_EQ(f->numRegions(), 2 * 2048);
+    EXPECT_EQ(f->numRegions(), 2 * 1024);
     EXPECT_EQ(f->layout().count(), 256);  // 16x16
+    EXPECT_TRUE(f->params().patchLookup);
     EXPECT_TRUE(f->params().alphaVisits);
     EXPECT_EQ(f->params().warmup, 8.0);
     EXPECT_EQ(f->params().smooth, 2.0);
@@ -173,10 +174,10 @@ TEST(HemiField, DefaultsAndMemory) {
     const size_t block = 256 * 20 + 257 * 4;
     const size_t perRegion = size_t(f->numRegions()) * (64 + 4);
     EXPECT_GE(f->bytes(), perRegion + block);
-    // Points, tree and the lookup's cell memo: 16384 entries of one cache line.
+    // Points, tree and the lookup's cell memo: 8192 entries of one cache line.
     ASSERT_NE(f->cellCache(), nullptr);
-    EXPECT_EQ(f->cellCache()->bytes(), 2048u * 8u * 64u);
-    EXPECT_LE(f->bytes(), perRegion + block + 2048 * 64 + f->cellCache()->bytes());
+    EXPECT_EQ(f->cellCache()->bytes(), 1024u * 8u * 64u);
+    EXPECT_LE(f->bytes(), perRegion + block + 1024 * 64 + f->cellCache()->bytes());
     EXPECT_EQ(f->learnedRegions(), 0u);
     EXPECT_FALSE(f->describe().empty());
     // Record buffers are scratch, reported apart from the learned data.
