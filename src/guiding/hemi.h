@@ -43,8 +43,10 @@ struct HemiParams {
     // (veach-bidir: 1161 regions learned of 2048 points' 4096), and with every point in use
     // 2048 points learned slower (veach-bidir 64 spp, seeds 2-5: cell 0.142/0.141/0.139/0.129,
     // patches with 2048 points 0.154/0.163/0.147/0.141, with 1024 0.137/0.143/0.144/0.131).
-    // At 30 s against none (docs/BENCHMARKS.md) 1024 matches or beats 2048 on every scene,
-    // with half the tables.
+    // At equal time (about 30 s of a core, both core orders, docs/BENCHMARKS.md) 1024 points
+    // match or beat 2048 where guiding matters (veach-bidir 0.38/0.37 against 0.39/0.38 of
+    // none's relMSE, breakfast 0.49/0.49 against 0.49/0.47, conference-room 0.86/0.87
+    // against 1.00/0.88), with half the tables; 512 lose breakfast (0.52/0.51).
     uint64_t points = 1024;
     double normalAngleDeg = 30;  // admissible normal deviation
     double init = 1e-3;          // initial Q
