@@ -285,7 +285,11 @@ int main(int argc, char** argv) {
         j["zero_contribution_fraction"] = s.paths ? double(s.zeroRadiancePaths) / s.paths : 0.0;
         j["mean_path_length"] = s.paths ? double(s.vertices) / s.paths : 0.0;
         j["guide"] = guide;
-        j["guide_bytes"] = field ? field->bytes() : 0;
+        // The field's tables and the surface patches it asked for (render/patches.h).
+        j["guide_bytes"] = field ? field->bytes() + (guideSettings.patches
+                                                         ? guideSettings.patches->bytes()
+                                                         : 0)
+                                 : 0;
         if (field) {
             guiding::GuidingStats gs = field->stats();
             j["guide_records"] = gs.records;

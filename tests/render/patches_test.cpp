@@ -87,6 +87,18 @@ TEST(SurfacePatches, CutsPerTriangleFromTheLongestEdge) {
     EXPECT_EQ(none.key(si), SurfacePatches::kNone);
     Vec3 p, n;
     EXPECT_FALSE(patches.centre(patches.count(), &p, &n));
+    // Coordinates out of [0, 1] (rounding) or NaN clamp to the triangle's cells.
+    SurfaceInteraction odd;
+    odd.primitive = 0;  // the quad
+    odd.primID = 1;     // its second triangle: patches [144, 288)
+    for (Vec2 bary : {Vec2(-0.5f, 1.5f), Vec2(std::nanf(""), 2e30f), Vec2(1.f, 1.f)}) {
+        odd.bary = bary;
+        const uint32_t key = patches.key(odd);
+        EXPECT_GE(key, 144u);
+        EXPECT_LT(key, 288u);
+    }
+    odd.bary = Vec2(-0.5f, 1.5f);
+    EXPECT_EQ(patches.key(odd), 144u + 11u);  // cell (0, 11)
 }
 
 // Each patch's centre, hit by a ray, gives back that patch's key; hits spread over the
