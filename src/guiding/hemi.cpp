@@ -72,7 +72,6 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         // per point leave the table at most three quarters full on usual scenes.
         const double spacing =
             std::sqrt(std::max(scene.totalArea, 0.0) / double(positions_.size()));
-        spacing_ = float(spacing);
         cache_ = std::make_unique<CellCache>(scene.boundsMin, scene.boundsMax, float(spacing),
                                              positions_.size() * 8);
     }
@@ -121,23 +120,21 @@ int HemiField::lookup(const glm::vec3& p, const glm::vec3& n) const {
         float d2 = 0.f;
         const int nearest = tree_->nearest(p, &d2);
         if (nearest >= 0) {
-            const float c = glm::dot(n, normals_[size_t(nearest)]);
-            if (std::abs(c) >= threshold) return prefetched(nearest * 2 + (c >= 0.f ? 0 : 1));
+            const int region = admissibleRegion(uint32_t(nearest), n, threshold);
+            if (region >= 0) return prefetched(region);
             if (params_.knn == 1) return -1;
         }
         found = tree_->knn(p, params_.knn, idx, dist2);
     }
     for (int i = 0; i < found; ++i) {
-        const float c = glm::dot(n, normals_[candidates[i]]);
-        // Of the point's two hemispheres (n, -n), take the closer one if it is admissible.
-        if (std::abs(c) >= threshold)
-            return prefetched(int(candidates[i]) * 2 + (c >= 0.f ? 0 : 1));
+        const int region = admissibleRegion(candidates[i], n, threshold);
+        if (region >= 0) return prefetched(region);
     }
     return -1;
 }
 
 float HemiField::patchSize() const {
-    return params_.patchLookup && cache_ && std::isfinite(spacing_) ? spacing_ : 0.f;
+    return params_.patchLookup && cache_ ? cache_->cellSize() : 0.f;
 }
 
 void HemiField::setPatches(uint32_t count,
@@ -162,7 +159,7 @@ uint32_t HemiField::fillPatch(uint32_t patch) const {
     float dist2[PointKdTree::kMaxK];
     const int found = tree_->knn(c, params_.knn, idx, dist2);
     for (int i = 0; i < found; ++i)
-        if (std::abs(glm::dot(n, normals_[idx[i]])) >= cosMaxAngle_) return idx[i] + 1;
+        if (admissibleRegion(idx[i], n, cosMaxAngle_) >= 0) return idx[i] + 1;
     return kNoPoint;
 }
 
@@ -175,12 +172,12 @@ int HemiField::lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& 
         }
         if (v != kNoPoint) {
             // The patch's point, if admissible for n as well (a shading normal may lean
-            // further than the patch's): of its two hemispheres, the one on n's side.
-            const uint32_t point = v - 1;
+            // further than the patch's). A zero or non-finite n fails here and in lookup.
             const float nLen = glm::length(n);
-            const float c = glm::dot(n, normals_[point]);
-            if (nLen > 0.f && std::isfinite(nLen) && std::abs(c) >= cosMaxAngle_ * nLen)
-                return prefetched(int(point) * 2 + (c >= 0.f ? 0 : 1));
+            const int region = nLen > 0.f && std::isfinite(nLen)
+                                   ? admissibleRegion(v - 1, n, cosMaxAngle_ * nLen)
+                                   : -1;
+            if (region >= 0) return prefetched(region);
         }
     }
     return lookup(p, n);

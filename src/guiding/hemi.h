@@ -243,9 +243,14 @@ private:
     std::unique_ptr<uint32_t[], FreeDeleter> patchPoint_;
     uint32_t numPatches_ = 0;
     std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> patchCentre_;
-    float spacing_ = 0.f;  // the points' mean spacing: cells' and patches' size
     // The memo entry of a patch (kNoPoint if none admissible).
     uint32_t fillPatch(uint32_t patch) const;
+    // Of a point's two hemispheres (n, -n), the region on n's side if the point's normal is
+    // admissible for n (|dot(n, normal)| >= threshold = cos(normal-angle) * |n|), else -1.
+    int admissibleRegion(uint32_t point, const glm::vec3& n, float threshold) const {
+        const float c = glm::dot(n, normals_[point]);
+        return std::abs(c) >= threshold ? int(point) * 2 + (c >= 0.f ? 0 : 1) : -1;
+    }
     // Per region, one cache line: the frame of its hemisphere (z = normal), the moment
     // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, its confidence, and the scale
     // that turns a stratum's probability back into its Q (policyRadiance).
