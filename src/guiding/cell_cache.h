@@ -30,6 +30,22 @@ inline void prefetchLine(const void* addr) {
 #endif
 }
 
+// Starts loading every cache line of [begin, begin + bytes): four prefetches per loop step,
+// the address stepping by the line (a loop over elements costs twice the instructions, at
+// every vertex of a guided path).
+inline void prefetchLines(const void* begin, size_t bytes) {
+    constexpr uintptr_t kLine = 64;
+    uintptr_t a = reinterpret_cast<uintptr_t>(begin) & ~(kLine - 1);
+    const uintptr_t end = reinterpret_cast<uintptr_t>(begin) + bytes;
+    for (; a + 3 * kLine < end; a += 4 * kLine) {
+        prefetchLine(reinterpret_cast<const void*>(a));
+        prefetchLine(reinterpret_cast<const void*>(a + kLine));
+        prefetchLine(reinterpret_cast<const void*>(a + 2 * kLine));
+        prefetchLine(reinterpret_cast<const void*>(a + 3 * kLine));
+    }
+    for (; a < end; a += kLine) prefetchLine(reinterpret_cast<const void*>(a));
+}
+
 class CellCache {
 public:
     static constexpr int kAxisBits = 21;  // cells per axis: at most 2^21

@@ -42,8 +42,12 @@ struct HemiFrame {
 // returned as it is: no square root or division on the per-vertex path.
 inline bool unitDirection(const glm::vec3& w, glm::vec3* unit) {
     const float len2 = glm::dot(w, w);
+    if (std::abs(len2 - 1.f) <= 1e-5f) {  // false for NaN
+        *unit = w;
+        return true;
+    }
     if (!(len2 > 0.f) || !std::isfinite(len2)) return false;
-    *unit = std::abs(len2 - 1.f) <= 1e-5f ? w : w / std::sqrt(len2);
+    *unit = w / std::sqrt(len2);
     return true;
 }
 

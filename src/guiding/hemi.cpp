@@ -189,16 +189,14 @@ int HemiField::prefetched(int region) const {
     // other work, e.g. a shadow ray, before its first query). Measured on cornell-box, 16 spp:
     // -17% profile samples of a guided render.
     prefetchLine(&frames_[size_t(region)]);
-    const float* c = cdf(region);
-    for (int i = 0; i <= strata_; i += 16) prefetchLine(c + i);
+    prefetchLines(cdf(region), size_t(strata_ + 1) * sizeof(float));
     // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
     // targets): a read without the prefetch waits (cornell-box, 64 spp, perf: radiance() 705
     // -> 27 samples, prefetched() 0 -> 394, lookup() 789 -> 501, of about 15000). The
     // roulette's policyRadiance reads the CDF instead: 16 prefetches less, -4.2% time
     // (0.942 .. 0.974) with target=path (docs/BENCHMARKS.md, session 14).
     if (prefetchEstimates_) {
-        const float* e = table_.estimates(size_t(region));
-        for (int i = 0; i < strata_; i += 16) prefetchLine(e + i);
+        prefetchLines(table_.estimates(size_t(region)), size_t(strata_) * sizeof(float));
     }
     return region;
 }

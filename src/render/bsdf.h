@@ -55,6 +55,24 @@ class BSDF {
         for (int i = 0; i < n_; ++i) count += matchesFlags(flags_[i], flags) ? 1 : 0;
         return count;
     }
+    // One pass over the lobes for the counts the integrator asks at every vertex: all lobes
+    // (numComponents()), the non-specular ones (numComponents(All & ~Specular)) and the diffuse
+    // ones (numComponents(Reflection | Transmission | Diffuse)).
+    struct LobeCounts {
+        int all = 0, smooth = 0, diffuse = 0;
+    };
+    LobeCounts lobeCounts() const {
+        constexpr BxDFFlags kSmooth = BxDFFlags::All & ~BxDFFlags::Specular;
+        constexpr BxDFFlags kDiffuse =
+            BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Diffuse;
+        LobeCounts c;
+        c.all = n_;
+        for (int i = 0; i < n_; ++i) {
+            c.smooth += matchesFlags(flags_[i], kSmooth) ? 1 : 0;
+            c.diffuse += matchesFlags(flags_[i], kDiffuse) ? 1 : 0;
+        }
+        return c;
+    }
     // True if there is at least one lobe and all lobes are specular (delta distributions).
     bool isDelta() const;
     // Union of the flags of all lobes.

@@ -161,19 +161,14 @@ Vec3 spawnOrigin(const SurfaceInteraction& si, const Vec3& w, float smallScale) 
 // The share of a guidable BSDF's lobes that are diffuse: the guide's table (Q cos, no BSDF
 // product) suits diffuse lobes; a glossy lobe is narrower than a stratum and is better
 // sampled by the BSDF. The integrator scales its guide probability by this share.
-// `all` is bsdf.numComponents().
-float diffuseShare(const BSDF& bsdf, int all) {
-    return all > 0 ? float(bsdf.numComponents(BxDFFlags::Reflection | BxDFFlags::Transmission |
-                                              BxDFFlags::Diffuse)) /
-                         float(all)
-                   : 0.f;
+float diffuseShare(const BSDF::LobeCounts& lobes) {
+    return lobes.all > 0 ? float(lobes.diffuse) / float(lobes.all) : 0.f;
 }
 
-// A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide). `all` is
-// bsdf.numComponents(), `smooth` bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular)
-// (numComponents counts lobes whose flags are all among the requested ones, so "specular
-// lobes" are the lobes not counted without the Specular bit).
-bool guidable(int all, int smooth) { return all > 0 && smooth == all; }
+// A BSDF the guide may drive: no delta lobes (delta BSDFs bypass the guide; a lobe counts
+// as smooth when its flags are all among All & ~Specular, so "specular lobes" are the lobes
+// not counted as smooth).
+bool guidable(const BSDF::LobeCounts& lobes) { return lobes.all > 0 && lobes.smooth == lobes.all; }
 
 // A guided vertex of the path whose direction sample feeds the selection learning (mix=learn):
 // the radiance the path gathers after it, over the throughput at it, is the sample's
@@ -565,10 +560,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (bounces >= maxDepth_ && !pending.active()) break;
         bsdf.clear();
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
-        // Lobe counts, asked once: all lobes and the non-specular ones.
-        const int lobes = bsdf.numComponents();
-        const int smoothLobes = bsdf.numComponents(BxDFFlags::All & ~BxDFFlags::Specular);
-        const bool canGuide = field && guidable(lobes, smoothLobes);
+        // Lobe counts, in one pass: all lobes, the non-specular and the diffuse ones.
+        const BSDF::LobeCounts lobeCounts = bsdf.lobeCounts();
+        const int lobes = lobeCounts.all;
+        const int smoothLobes = lobeCounts.smooth;
+        const bool canGuide = field && guidable(lobeCounts);
         int region = -1;
         if (canGuide && wantsRegion) {
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
@@ -577,7 +573,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const bool lastVertex = bounces >= maxDepth_;
         // The guide's probability here: mix x the region's confidence x the diffuse share.
         const float share =
-            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(bsdf, lobes) : 0.f;
+            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobeCounts) : 0.f;
         const int sampleRegion = share > 0.f ? region : -1;
         VertexGuide vertexGuide{sampleRegion, share};
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the

@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
                    "strata (WxH), points, normal-angle, init, epsilon, cosine, smooth, max-mb, "
                    "target (path, sample or sum), rr (adjoint or pbrt), rr-window, samples, auto (N "
                    "spp: a guided-or-plain trial; default off), learn (N spp or all); hemi: knn, warmup, lookup "
-                   "(cell or exact); vdb: "
+                   "(patch, cell or exact); vdb: "
                    "voxel, voxel-size, dirs, normals, warmup, volume, volume-voxel "
                    "(README.md)");
     app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering");

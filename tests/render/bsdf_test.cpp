@@ -677,6 +677,41 @@ TEST(BSDF, ComponentsFlagsAndDelta) {
     EXPECT_FALSE(full.add(LambertianReflection()));
 }
 
+// lobeCounts() is the integrator's one-pass form of three numComponents queries.
+TEST(BSDF, LobeCountsMatchNumComponents) {
+    auto expectCounts = [](const BSDF& b, const char* what) {
+        SCOPED_TRACE(what);
+        const BSDF::LobeCounts c = b.lobeCounts();
+        EXPECT_EQ(c.all, b.numComponents());
+        EXPECT_EQ(c.smooth, b.numComponents(BxDFFlags::All & ~BxDFFlags::Specular));
+        EXPECT_EQ(c.diffuse, b.numComponents(BxDFFlags::Reflection | BxDFFlags::Transmission |
+                                             BxDFFlags::Diffuse));
+    };
+    BSDF b;
+    expectCounts(b, "empty");
+    EXPECT_EQ(b.lobeCounts().all, 0);
+    buildMirror(b, Spectrum(0.9f));
+    expectCounts(b, "mirror");
+    EXPECT_EQ(b.lobeCounts().smooth, 0);
+    b.clear();
+    buildPlastic(b, Spectrum(0.5f), Spectrum(0.3f), 0.1f, true);
+    expectCounts(b, "plastic");
+    EXPECT_EQ(b.lobeCounts().diffuse, 1);
+    EXPECT_EQ(b.lobeCounts().smooth, 2);
+    b.clear();
+    buildMatte(b, Spectrum(0.5f), 0.f);
+    expectCounts(b, "matte");
+    EXPECT_EQ(b.lobeCounts().diffuse, 1);
+    b.clear();
+    buildGlass(b, Spectrum(1.f), Spectrum(1.f), 1.5f, 0.f, 0.f, false);
+    expectCounts(b, "glass");
+    b.clear();
+    buildTranslucent(b, Spectrum(0.4f), Spectrum(0.3f), Spectrum(0.5f), Spectrum(0.5f), 0.1f,
+                     true);
+    expectCounts(b, "translucent");
+    EXPECT_EQ(b.lobeCounts().diffuse, 2);
+}
+
 TEST(Builders, LobesFollowPbrtMaterials) {
     BSDF b;
     buildMatte(b, Spectrum(0.5f), 0.f);
