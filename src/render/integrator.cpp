@@ -180,6 +180,12 @@ struct SelectionVertex {
     float lumBeta;  // luminance of the throughput at the vertex
 };
 constexpr int kMaxSelectionVertices = 16;
+// A path's selection vertices, left uninitialised until used: value-initialising all of
+// them cost every path 48 instructions, and only mix=learn uses them.
+union SelectionVertices {
+    SelectionVertices() {}
+    SelectionVertex v[kMaxSelectionVertices];
+};
 
 // Adjoint-driven roulette (GuideSettings::adjointRoulette): the first bounce it may end a
 // path at, the least survival probability (bounds a survivor's weight), and the confidence a
@@ -401,7 +407,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     guiding::GuidingField* field = guide_.field;
     const bool learn = field && guide_.learn;
     PendingRecord pending;
-    SelectionVertex selVerts[kMaxSelectionVertices];
+    SelectionVertices selVerts;
     int numSelVerts = 0;
     const bool learnSelection = learn && guide_.learnMix;
     // Training targets of surface vertices: the path's returns, or Eq. 1 bootstrapped at the
@@ -418,7 +424,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     };
     auto pushSelection = [&](int region, const DirectionSample& ds) {
         if (!learnSelection || region < 0 || numSelVerts >= kMaxSelectionVertices) return;
-        selVerts[numSelVerts++] = SelectionVertex{
+        selVerts.v[numSelVerts++] = SelectionVertex{
             region, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
             luminance(L), luminance(beta)};
     };
@@ -665,7 +671,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     if (numSelVerts > 0) {
         const float lumL = luminance(L);
         for (int i = 0; i < numSelVerts; ++i) {
-            SelectionVertex& v = selVerts[i];
+            SelectionVertex& v = selVerts.v[i];
             v.s.integrand = (lumL - v.lumL) / v.lumBeta * v.s.pdf;
             field->recordSelection(slot, v.region, v.s);
         }
