@@ -201,14 +201,8 @@ int HemiField::prefetched(int region) const {
     return region;
 }
 
-int HemiField::stratumOf(int region, const glm::vec3& w) const {
-    glm::vec3 unit;
-    if (!validRegion(region) || !unitDirection(w, &unit)) return -1;
-    return layout_.stratumOf(frames_[size_t(region)].frame.toLocal(unit));
-}
-
 float HemiField::pdf(int region, const glm::vec3& w, int* bin) const {
-    const int j = stratumOf(region, w);
+    const int j = stratumIn(region, w);
     if (bin) *bin = j;
     if (j < 0) return 0.f;
     return strataProbability(cdf(region), j) * layout_.density();
