@@ -7,8 +7,11 @@ Per scene and configuration: relMSE at the common end time (the shortest run's l
 log-log interpolation of each curve), its ratio to `none`, the break-even time (from when on
 the configuration's curve stays below none's), the overhead per sample (seconds per spp
 relative to none) and per path vertex (the same divided by the mean path lengths' ratio:
-what a vertex costs, apart from paths that grow or shrink), the zero-contribution fraction,
-mean path length and guide memory.
+what a vertex costs, apart from paths that grow or shrink), the overhead at plain path
+length (the overhead per sample divided by max(1, path length / none's): per vertex where
+the configuration's paths are longer than none's, per sample where they are not, so that
+longer paths that carry light are not charged as the guide's cost; docs/BENCHMARKS.md,
+session 18), the zero-contribution fraction, mean path length and guide memory.
 With --plots: OUTDIR/curves.png (relMSE against seconds, log-log, one panel per scene) and
 OUTDIR/images.png (the final images side by side with the reference, all at equal time;
 needs build/rlpbrt-imgtool to convert EXR to PNG).
@@ -74,9 +77,9 @@ def main():
                 stats = json.load(f)
         runs.setdefault(scene, {})[config] = (read_curve(path), stats)
     print("| scene | config | spp | relMSE at equal time | ratio to none | break-even s "
-          "| overhead/sample | overhead/vertex | zero-contribution | mean path length "
-          "| guide MiB |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "| overhead/sample | overhead/vertex | overhead at plain path length "
+          "| zero-contribution | mean path length | guide MiB |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for scene, configs in runs.items():
         curves = [c for c, _ in configs.values() if c]
         if not curves:
@@ -98,16 +101,18 @@ def main():
             length = st.get("mean_path_length")
             over_v = ((sps / length) / (base_sps / base_len) - 1
                       if sps and base_sps and length and base_len else None)
+            over_p = ((1 + over) / max(1.0, length / base_len) - 1
+                      if over is not None and length and base_len else None)
             fmt = lambda v, f: ("-" if v is None else f.format(v))
-            print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
+            print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
                 scene.split("__")[0], config, st.get("spp", "-"), fmt(e, "{:.4g}"),
                 fmt(ratio, "{:.2f}"),
                 ("never" if config != "none" and be is None and base_curve else fmt(be, "{:.2g}")),
-                fmt(over, "{:+.0%}"), fmt(over_v, "{:+.0%}"),
+                fmt(over, "{:+.0%}"), fmt(over_v, "{:+.0%}"), fmt(over_p, "{:+.0%}"),
                 fmt(st.get("zero_contribution_fraction"), "{:.3f}"),
                 fmt(st.get("mean_path_length"), "{:.2f}"),
                 fmt(st.get("guide_bytes", 0) / 2**20 if st else None, "{:.1f}")))
-        print("| | equal time: {:.1f} s | | | | | | | | | |".format(t_end))
+        print("| | equal time: {:.1f} s | | | | | | | | | | |".format(t_end))
     if not plots:
         return
     try:
