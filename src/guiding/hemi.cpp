@@ -202,7 +202,7 @@ int HemiField::prefetched(int region) const {
 }
 
 float HemiField::pdf(int region, const glm::vec3& w, int* bin) const {
-    const int j = stratumIn(region, w);
+    const int j = stratumOf(region, w);
     if (bin) *bin = j;
     if (j < 0) return 0.f;
     return strataProbability(cdf(region), j) * layout_.density();

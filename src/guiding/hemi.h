@@ -180,8 +180,13 @@ public:
         glm::vec3 n = normals_[size_t(region) / 2];
         return (region & 1) ? -n : n;
     }
-    // Stratum of world direction w in a region's hemisphere, -1 outside.
-    int stratumOf(int region, const glm::vec3& w) const { return stratumIn(region, w); }
+    // Stratum of world direction w in a region's hemisphere, -1 outside. Always inlined:
+    // pdf() asks it at every guided vertex.
+    [[gnu::always_inline]] int stratumOf(int region, const glm::vec3& w) const {
+        glm::vec3 unit;
+        if (!validRegion(region) || !unitDirection(w, &unit)) return -1;
+        return layout_.stratumOf(frames_[size_t(region)].frame.toLocal(unit));
+    }
     // The same, given the bin that pdf()/sample() reported for it (-1 or out of range: found
     // from w).
     int stratumOf(int region, const glm::vec3& w, int bin) const {
@@ -211,12 +216,6 @@ private:
     void updateRegion(int region, const double* q);
 
     bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
-    // stratumOf, inlined into the per-vertex queries (pdf at every vertex) rather than called.
-    [[gnu::always_inline]] int stratumIn(int region, const glm::vec3& w) const {
-        glm::vec3 unit;
-        if (!validRegion(region) || !unitDirection(w, &unit)) return -1;
-        return layout_.stratumOf(frames_[size_t(region)].frame.toLocal(unit));
-    }
     const float* cdf(int region) const { return table_.cdf(size_t(region)); }
     // Rebuilds a region's CDF, then its moment and confidence (called per updated region,
     // concurrently for distinct regions).

@@ -44,8 +44,8 @@ public:
         // Truncation is the floor for the non-negative barycentrics; values out of [0, k)
         // (rounding, NaN) clamp to the nearest cell before any conversion.
         const float fa = si.bary.x * k, fb = si.bary.y * k;
-        const uint32_t a = fa > 0.f ? (fa < k ? std::min(uint32_t(fa), last) : last) : 0u;
-        const uint32_t b = fb > 0.f ? (fb < k ? std::min(uint32_t(fb), last) : last) : 0u;
+        const uint32_t a = fa > 0.f ? (fa < k ? uint32_t(fa) : last) : 0u;
+        const uint32_t b = fb > 0.f ? (fb < k ? uint32_t(fb) : last) : 0u;
         return t.first + a * t.cuts + b;
     }
     // A point of the patch (the centre of its part of the triangle) and the unit geometric
