@@ -6,6 +6,8 @@
 #include <cstring>
 
 #include "render/media.h"
+#include "render/path_recorder.h"
+#include "render/roulette.h"
 #include "render/sampling.h"
 
 namespace rlpbrt {
@@ -170,23 +172,6 @@ float diffuseShare(const BSDF::LobeCounts& lobes) {
 // not counted as smooth).
 bool guidable(const BSDF::LobeCounts& lobes) { return lobes.all > 0 && lobes.smooth == lobes.all; }
 
-// A guided vertex of the path whose direction sample feeds the selection learning (mix=learn):
-// the radiance the path gathers after it, over the throughput at it, is the sample's
-// contribution F = f cos Li / pdf, so its integrand is F * pdf (known when the path ends).
-struct SelectionVertex {
-    int region;
-    guiding::SelectionSample s;
-    float lumL;     // luminance of L when the direction was sampled
-    float lumBeta;  // luminance of the throughput at the vertex
-};
-constexpr int kMaxSelectionVertices = 16;
-// A path's selection vertices, left uninitialised until used: value-initialising all of
-// them cost every path 48 instructions, and only mix=learn uses them.
-union SelectionVertices {
-    SelectionVertices() {}
-    SelectionVertex v[kMaxSelectionVertices];
-};
-
 // Adjoint-driven roulette (GuideSettings::adjointRoulette): the first bounce it may end a
 // path at, the least survival probability (bounds a survivor's weight), and the confidence a
 // region needs before its Q is trusted.
@@ -194,32 +179,9 @@ constexpr int kRouletteFirstBounce = 1;
 constexpr float kMinSurvival = 0.25f;
 constexpr float kRouletteConfidence = 0.5f;
 
-// A guided vertex trained with the path's return (target=path): the radiance the path
-// gathered after it, over the throughput after its direction sample, is the radiance that
-// direction brought to it, as the estimator counts it: emission found by the direction
-// carries its MIS weight against the vertex's next-event estimation.
-struct ReturnVertex {
-    int region;
-    int bin;  // the guide's bin of w in region, or -1
-    Vec3 w;
-    Spectrum L;     // L when the direction was sampled (after the vertex's NEE)
-    Spectrum beta;  // throughput after the direction's weight
-};
-constexpr int kMaxReturnVertices = 32;
-
-// The pending training record of the last guided vertex: its region and direction, and the
-// target collected so far through delta vertices (weight = product of their f cos / pdf).
-struct PendingRecord {
-    int region = -1;
-    Vec3 w{0.f};
-    int bin = -1;  // the guide's bin of w in region, or -1
-    float target = 0.f;
-    float weight = 1.f;
-    bool active() const { return region >= 0; }
-};
 }  // namespace
 
-PathIntegrator::DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
+DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
                                                                 const BSDF& bsdf,
                                                                 VertexGuide& guide,
                                                                 Sampler& sampler) const {
@@ -312,7 +274,7 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
     return tr;
 }
 
-PathIntegrator::DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
+DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
                                                                       VertexGuide& guide,
                                                                       Sampler& sampler) const {
     DirectionSample ds;
@@ -362,104 +324,79 @@ Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float 
     return phase * tr * ls.L * (w / lightPdf);
 }
 
-float PathIntegrator::scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                                      const Vec3& woY) const {
-    Vec3 n = glm::dot(si.ns, woY) >= 0.f ? si.ns : -si.ns;
-    // Lambertian y: the sum is rho/pi times the learned irradiance (no BSDF evaluations).
-    Spectrum albedo(0.f);
-    bool lambertian = true;
-    for (int i = 0; i < bsdf.numComponents() && lambertian; ++i) {
-        if (const auto* l = bsdf.component(i).get<LambertianReflection>()) albedo += l->r;
-        else lambertian = false;
+PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
+                                                const SurfaceInteraction& si, int bounces,
+                                                Sampler& sampler, PathStats& stats,
+                                                PathRecorder& rec) const {
+    // Free flight to the surface (or to infinity) through the current medium.
+    const Medium& medium = *scene_.media[size_t(s.pm.medium)];
+    MediumSample ms = medium.sample(s.ray.o, s.ray.d, found ? si.t : s.ray.tMax, *s.pm.rng);
+    s.beta *= ms.weight;
+    if (isBlack(s.beta) || !isFinite(s.beta)) return Step::End;
+    // The pending target is radiance arriving at its vertex: weighted by the flight.
+    rec.flight(ms.weight);
+    if (!ms.scattered) return Step::Surface;
+    // A medium vertex: NEE with MIS against the direction sampling, then a direction from the
+    // phase function, mixed with the guide where the field has a volume cell (the field is
+    // asked to model this place otherwise).
+    if (bounces >= maxDepth_) return Step::End;
+    const Vec3 p = s.ray.o + ms.t * s.ray.d, wo = -s.ray.d;
+    int region = -1;
+    if (guide_.field) {
+        region = guide_.field->lookupMedium(p);
+        if (region < 0) rec.requestMedium(p);
     }
-    if (lambertian) return luminance(albedo) * InvPi * guide_.field->irradianceEstimate(region, n);
-    if (guide_.sampledTarget) return -1.f;  // estimated with the direction sampled at y
-    struct Ctx {
-        const BSDF& bsdf;
-        Vec3 wo, n;
-    } ctx{bsdf, woY, n};
-    const Ctx* c = &ctx;  // one captured pointer: no allocation in std::function
-    return guide_.field->scatteredEstimate(region, [c](const glm::vec3& wj) {
-        float cosj = glm::dot(wj, c->n);
-        return cosj > 0.f ? luminance(c->bsdf.f(c->wo, wj)) * cosj : 0.f;
-    });
-}
-
-bool PathIntegrator::pbrtRoulette(Spectrum* beta, float etaScale, int bounces,
-                                  Sampler& sampler) const {
-    const float m = maxComponent(*beta * etaScale);
-    if (!(m < rrThreshold_) || bounces <= 3) return true;
-    const float q = std::max(0.05f, 1.f - m);
-    if (sampler.get1D() < q) return false;
-    *beta /= 1.f - q;
-    return true;
+    const int sampleRegion = guide_.mix > 0.f ? region : -1;
+    ++stats.vertices;
+    VertexGuide vertexGuide{sampleRegion, 1.f};
+    s.L += s.beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, s.pm, sampler, stats);
+    DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, sampler);
+    rec.mediumScattered(region, ds);
+    if (!(ds.pdf > 0.f)) return Step::End;
+    rec.selectionVertex(sampleRegion, ds, s.L, s.beta);
+    s.beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
+    s.dirPdf = ds.pdf;
+    s.specularBounce = false;
+    s.prev = LightSampleContext{p, Vec3(0.f)};
+    s.ray = Ray(p, ds.wi);
+    if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) return Step::End;
+    return Step::Scattered;
 }
 
 Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& stats,
                             int slot, float pixelEstimate) const {
-    Spectrum L(0.f), beta(1.f);
-    Ray ray = cameraRay;
-    bool specularBounce = false;
-    float dirPdf = 0.f, etaScale = 1.f;
-    LightSampleContext prev;
+    PathState s;
+    s.ray = cameraRay;
     int passThroughs = 0;
     BSDF bsdf;
     guiding::GuidingField* field = guide_.field;
-    const bool learn = field && guide_.learn;
-    PendingRecord pending;
-    SelectionVertices selVerts;
-    int numSelVerts = 0;
-    const bool learnSelection = learn && guide_.learnMix;
-    // Training targets of surface vertices: the path's returns, or Eq. 1 bootstrapped at the
-    // next vertex (pending). Medium vertices always bootstrap: in a lossless medium the noisy
-    // returns made a pure policy's phase / pdf weights heavy-tailed over the many vertices of
-    // a thick medium (vdb, mix 1: mean 0.53 +- 0.04 of an exact 1 at 64 spp).
-    const bool bootstrap = learn && !guide_.pathTarget;
-    const bool returns = learn && guide_.pathTarget;
-    ReturnVertex retVerts[kMaxReturnVertices];
-    int numRet = 0;
-    auto pushReturn = [&](int region, const Vec3& w, int bin) {
-        if (returns && region >= 0 && numRet < kMaxReturnVertices)
-            retVerts[numRet++] = ReturnVertex{region, bin, w, L, beta};
-    };
-    auto pushSelection = [&](int region, const DirectionSample& ds) {
-        if (!learnSelection || region < 0 || numSelVerts >= kMaxSelectionVertices) return;
-        selVerts.v[numSelVerts++] = SelectionVertex{
-            region, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
-            luminance(L), luminance(beta)};
-    };
+    PathRecorder rec(guide_, slot);
     // Media (volpath): the medium the ray travels in; tracking decisions use a per-path
     // generator seeded from two sampler dimensions. Scenes without media skip all of it.
     const bool media = scene_.hasMedia();
     Rng rng;
-    PathMedium pm;
     if (media) {
         uint32_t a, b;
         float ua = sampler.get1D(), ub = sampler.get1D();
         std::memcpy(&a, &ua, 4);
         std::memcpy(&b, &ub, 4);
         rng.setSeed((uint64_t(a) << 32) | b, uint64_t(slot));
-        pm.medium = scene_.cameraMedium;
-        pm.rng = &rng;
+        s.pm.medium = scene_.cameraMedium;
+        s.pm.rng = &rng;
     }
-    auto flush = [&](float addTarget) {
-        if (!pending.active()) return;
-        pending.target += pending.weight * addTarget;
-        field->record(slot, pending.region, pending.w, pending.target, pending.bin);
-        pending = PendingRecord();
-    };
     for (int bounces = 0;; ++bounces) {
+        // The closest hit. The path's last direction (no vertex after it) brings back only
+        // the emission it hits, weighted against this vertex's next-event estimation: the
+        // learned Q, the light of whole returns, overstates what it can find there, and its
+        // truncated return would understate Q for the vertices before the last. It samples
+        // the BSDF and records no return (Eq. 1 targets, bootstrapped from Q, are learned
+        // there as everywhere), so a surface vertex looks up a region only before it or to
+        // bootstrap.
         SurfaceInteraction si;
         ++stats.rays;
-        bool found = scene_.intersect(ray, &si);
-        // The path's last direction (no vertex after it) brings back only the emission it
-        // hits, weighted against this vertex's next-event estimation: the learned Q, the light
-        // of whole returns, overstates what it can find there, and its truncated return would
-        // understate Q for the vertices before the last. It samples the BSDF and records no
-        // return (Eq. 1 targets, bootstrapped from Q, are learned there as everywhere), so a
-        // surface vertex looks up a region only before it or to bootstrap.
+        const bool found = scene_.intersect(s.ray, &si);
         const bool lastDirection = bounces + 1 >= maxDepth_;
-        const bool wantsRegion = field && (!lastDirection || bootstrap);
+        const bool wantsRegion = field && (!lastDirection || rec.bootstraps());
         // The lookup below reads a table entry for si.p: start loading it (a cache miss
         // otherwise; the material evaluation runs in between).
         uint32_t patch = SurfacePatches::kNone;
@@ -467,74 +404,32 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             if (guide_.patches) patch = guide_.patches->key(si);
             field->prefetchPatch(patch, si.p);
         }
-        if (media && pm.medium >= 0) {
-            // Free flight to the surface (or to infinity) through the current medium.
-            const Medium& medium = *scene_.media[size_t(pm.medium)];
-            MediumSample ms = medium.sample(ray.o, ray.d, found ? si.t : ray.tMax, rng);
-            beta *= ms.weight;
-            if (isBlack(beta) || !isFinite(beta)) break;
-            // The pending target is radiance arriving at its vertex: weighted by the flight.
-            if (pending.active()) pending.weight *= luminance(ms.weight);
-            if (ms.scattered) {
-                // A medium vertex: NEE with MIS against the direction sampling, then a
-                // direction from the phase function, mixed with the guide where the field
-                // has a volume cell (the field is asked to model this place otherwise).
-                if (bounces >= maxDepth_) break;
-                Vec3 p = ray.o + ms.t * ray.d, wo = -ray.d;
-                int region = -1;
-                if (field) {
-                    region = field->lookupMedium(p);
-                    if (region < 0 && learn) field->requestMedium(slot, p);
-                }
-                const int sampleRegion = guide_.mix > 0.f ? region : -1;
-                ++stats.vertices;
-                VertexGuide vertexGuide{sampleRegion, 1.f};
-                L += beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, pm, sampler, stats);
-                DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, sampler);
-                if (learn) {
-                    // Eq. 1 for the previous vertex, with the one-sample estimate of the
-                    // light scattered here: Q(p, w') phase(w') / pdf(w').
-                    if (pending.active() && region >= 0 && ds.pdf > 0.f) {
-                        const float est = field->radiance(region, ds.wi, ds.bin) * ds.f.x / ds.pdf;
-                        flush(std::isfinite(est) ? est : 0.f);
-                    }
-                    pending = PendingRecord();
-                    if (region >= 0 && ds.pdf > 0.f) {
-                        pending.region = region;
-                        pending.w = ds.wi;
-                        pending.bin = ds.bin;
-                    }
-                }
-                if (!(ds.pdf > 0.f)) break;
-                pushSelection(sampleRegion, ds);
-                const Vec3 wi = ds.wi;
-                beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
-                dirPdf = ds.pdf;
-                specularBounce = false;
-                prev = LightSampleContext{p, Vec3(0.f)};
-                ray = Ray(p, wi);
-                if (!pbrtRoulette(&beta, etaScale, bounces, sampler)) break;
-                continue;
-            }
+
+        // Media: a free flight to the hit; a scattering event is a medium vertex.
+        if (media && s.pm.medium >= 0) {
+            const Step step = mediumStep(s, found, si, bounces, sampler, stats, rec);
+            if (step == Step::End) break;
+            if (step == Step::Scattered) continue;
         }
+
         // Emission reached by the previous scattering (or seen by the camera), weighted by
         // MIS against next-event estimation.
         if (!found) {
             float envLum = 0.f;
             for (int idx : scene_.infiniteLights) {
                 const Light& light = *scene_.lights[size_t(idx)];
-                Spectrum Le = light.Le(ray.d);
+                Spectrum Le = light.Le(s.ray.d);
                 if (isBlack(Le)) continue;
                 envLum += luminance(Le);
-                if (bounces == 0 || specularBounce) {
-                    L += beta * Le;
+                if (bounces == 0 || s.specularBounce) {
+                    s.L += s.beta * Le;
                 } else {
-                    float lightPdf = lights_->pmf(prev.p, idx) *
-                                     light.pdfLi(prev, ray.d, Vec3(0.f), Vec3(0.f));
-                    L += beta * Le * powerHeuristic(1, dirPdf, 1, lightPdf);
+                    float lightPdf = lights_->pmf(s.prev.p, idx) *
+                                     light.pdfLi(s.prev, s.ray.d, Vec3(0.f), Vec3(0.f));
+                    s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
                 }
             }
-            if (learn) flush(envLum);
+            rec.escaped(envLum);
             break;
         }
         float emitted = 0.f;
@@ -543,140 +438,99 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             Spectrum Le = light.L(si.p, si.ng, si.uv, si.wo);
             if (!isBlack(Le)) {
                 emitted = luminance(Le);
-                if (bounces == 0 || specularBounce) {
-                    L += beta * Le;
+                if (bounces == 0 || s.specularBounce) {
+                    s.L += s.beta * Le;
                 } else {
-                    float lightPdf = lights_->pmf(prev.p, si.light) *
-                                     light.pdfLi(prev, ray.d, si.p, si.ng);
-                    L += beta * Le * powerHeuristic(1, dirPdf, 1, lightPdf);
+                    float lightPdf = lights_->pmf(s.prev.p, si.light) *
+                                     light.pdfLi(s.prev, s.ray.d, si.p, si.ng);
+                    s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
                 }
             }
         }
-        // Medium boundaries without a surface: continue the ray unchanged.
+
+        // Medium boundaries without a surface: continue the ray unchanged. (With media, as
+        // volpath, light found through boundaries after the last vertex still counts; path's
+        // shadow rays stop at them.)
         if (si.material < 0) {
-            // (With media, as volpath, light found through boundaries after the last vertex
-            // still counts; path's shadow rays stop at them.)
             if ((bounces >= maxDepth_ && !media) || ++passThroughs > 256) break;
-            if (pending.active()) pending.target += pending.weight * emitted;
-            if (media) pm.medium = si.mediumAfter(ray.d, pm.medium);
-            ray.o = spawnOrigin(si, ray.d, originScale_);
+            rec.passedThrough(emitted);
+            if (media) s.pm.medium = si.mediumAfter(s.ray.d, s.pm.medium);
+            s.ray.o = spawnOrigin(si, s.ray.d, originScale_);
             --bounces;
             continue;
         }
-        if (bounces >= maxDepth_ && !pending.active()) break;
+        if (bounces >= maxDepth_ && !rec.awaitsTarget()) break;
+
+        // The BSDF, and the guide here: its region, and the guide's probability (mix x the
+        // region's confidence x the BSDF's diffuse share).
         bsdf.clear();
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
-        // Lobe counts, in one pass: all lobes, the non-specular and the diffuse ones.
-        const BSDF::LobeCounts lobeCounts = bsdf.lobeCounts();
-        const int lobes = lobeCounts.all;
-        const int smoothLobes = lobeCounts.smooth;
-        const bool canGuide = field && guidable(lobeCounts);
+        const BSDF::LobeCounts lobes = bsdf.lobeCounts();
+        const bool canGuide = field && guidable(lobes);
         int region = -1;
         if (canGuide && wantsRegion) {
             Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
             region = field->lookupPatch(patch, si.p, nFacing);
         }
         const bool lastVertex = bounces >= maxDepth_;
-        // The guide's probability here: mix x the region's confidence x the diffuse share.
         const float share =
-            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobeCounts) : 0.f;
+            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
         const int sampleRegion = share > 0.f ? region : -1;
         VertexGuide vertexGuide{sampleRegion, share};
+
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
         if (!lastVertex) {
             ++stats.vertices;
-            if (smoothLobes > 0)
-                L += beta * sampleLight(si, bsdf, vertexGuide, sampler, stats,
-                                        media ? &pm : nullptr);
+            if (lobes.smooth > 0)
+                s.L += s.beta * sampleLight(si, bsdf, vertexGuide, sampler, stats,
+                                            media ? &s.pm : nullptr);
         }
-        // Eq. 1 target for the previous guided vertex: Le(y) + the learned light scattered at
-        // y, carried unchanged through delta vertices.
-        bool deferTarget = false;
-        if (learn && pending.active()) {
-            float scattered = region >= 0 ? scatteredTarget(si, bsdf, region, si.wo) : 0.f;
-            if (region >= 0 && scattered < 0.f && !lastVertex)
-                deferTarget = true;  // completed below with the direction sampled at y
-            else if (region >= 0)
-                flush(emitted + std::max(scattered, 0.f));
-            else if (canGuide || lobes == 0)
-                pending = PendingRecord();  // no data at y: nothing to learn from
-            else
-                pending.target += pending.weight * emitted;  // delta y: continue the chain
-        }
+        // Training: the previous guided vertex's Eq. 1 target, from the light found here.
+        const bool deferTarget =
+            rec.surfaceReached(si, bsdf, region, canGuide, lobes.all, emitted, lastVertex);
         if (lastVertex) break;
-        // Sample the next direction (the guiding seam).
+
+        // The next direction (the guiding seam), and what the guide learns from it.
         DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
-        if (deferTarget) {
-            // One-sample estimate of the Eq. 1 sum: Q(y, w') f(w') cos / pdf(w').
-            float est = 0.f;
-            if (ds.pdf > 0.f && !ds.transmission)
-                est = field->radiance(region, ds.wi, ds.bin) * luminance(ds.f) *
-                      std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
-            flush(emitted + (std::isfinite(est) ? est : 0.f));
-        }
+        rec.surfaceSampled(deferTarget, si, region, ds, emitted);
         if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
-        pushSelection(sampleRegion, ds);
-        Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
-        beta *= weight;
-        dirPdf = ds.pdf;
-        specularBounce = ds.specular;
-        pushReturn(ds.transmission || lastDirection ? -1 : region, ds.wi, ds.bin);
-        if (learn) {
-            if (bootstrap && region >= 0 && !ds.transmission) {
-                pending = PendingRecord();
-                pending.region = region;
-                pending.w = ds.wi;
-                pending.bin = ds.bin;
-            } else if (pending.active() && region < 0 && !canGuide) {
-                pending.weight *= luminance(weight);  // through a delta vertex
-            } else {
-                pending = PendingRecord();
-            }
-        }
+        rec.selectionVertex(sampleRegion, ds, s.L, s.beta);
+        const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
+        s.beta *= weight;
+        s.dirPdf = ds.pdf;
+        s.specularBounce = ds.specular;
+        rec.surfaceScattered(region, ds.transmission || lastDirection ? -1 : region, canGuide,
+                             ds, weight, s.L, s.beta);
+
+        // The next ray.
         if (ds.specular && ds.transmission) {
             float eta = bsdf.eta();
-            etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
+            s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
         }
-        prev = LightSampleContext{si.p, si.ng};
-        if (media) pm.medium = si.mediumAfter(ds.wi, pm.medium);
-        ray.o = spawnOrigin(si, ds.wi, originScale_);
-        ray.d = ds.wi;
-        ray.tMax = Infinity;
-        if (!isFinite(beta)) break;
-        // From the second vertex on: roulette on the expected contribution where the guide
-        // knows it.
+        s.prev = LightSampleContext{si.p, si.ng};
+        if (media) s.pm.medium = si.mediumAfter(ds.wi, s.pm.medium);
+        s.ray.o = spawnOrigin(si, ds.wi, originScale_);
+        s.ray.d = ds.wi;
+        s.ray.tMax = Infinity;
+        if (!isFinite(s.beta)) break;
+
+        // Russian roulette: from the second vertex on, on the expected contribution where
+        // the guide knows it; else pbrt-v3's.
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
             sampleRegion >= 0 && !ds.transmission &&
             guideConfidence(vertexGuide) >= kRouletteConfidence) {
             const float expected =
-                luminance(beta) * field->policyRadiance(sampleRegion, ds.wi, ds.bin);
-            const float low = guide_.rouletteWindow * pixelEstimate;
-            if (expected < low) {
-                const float survive = std::max(expected / low, kMinSurvival);
-                if (sampler.get1D() >= survive) break;
-                beta /= survive;
-            }
+                luminance(s.beta) * field->policyRadiance(sampleRegion, ds.wi, ds.bin);
+            if (!adjointRoulette(&s.beta, expected, guide_.rouletteWindow * pixelEstimate,
+                                 kMinSurvival, sampler))
+                break;
             continue;
         }
-        if (!pbrtRoulette(&beta, etaScale, bounces, sampler)) break;
+        if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) break;
     }
-    for (int i = 0; i < numRet; ++i) {
-        const ReturnVertex& v = retVerts[i];
-        const Spectrum d = L - v.L;
-        Spectrum li(0.f);
-        for (int c = 0; c < 3; ++c) li[c] = v.beta[c] > 0.f ? d[c] / v.beta[c] : 0.f;
-        field->record(slot, v.region, v.w, std::max(luminance(li), 0.f), v.bin);
-    }
-    if (numSelVerts > 0) {
-        const float lumL = luminance(L);
-        for (int i = 0; i < numSelVerts; ++i) {
-            SelectionVertex& v = selVerts.v[i];
-            v.s.integrand = (lumL - v.lumL) / v.lumBeta * v.s.pdf;
-            field->recordSelection(slot, v.region, v.s);
-        }
-    }
-    return L;
+    rec.finish(s.L);
+    return s.L;
 }
 
 }  // namespace rlpbrt

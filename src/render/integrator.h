@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "guiding/guiding.h"
+#include "render/direction_sample.h"
 #include "render/light_sampler.h"
 #include "render/patches.h"
 #include "render/ray.h"
@@ -112,6 +113,7 @@ struct GuideSettings {
 };
 
 class Rng;
+class PathRecorder;
 
 class PathIntegrator {
 public:
@@ -126,19 +128,6 @@ public:
     bool wantsPixelEstimate() const { return guide_.field && guide_.adjointRoulette; }
 
 private:
-    // The direction-sampling seam: a BSDF sample, or a guided one mixed with the BSDF.
-    struct DirectionSample {
-        Spectrum f{0.f};
-        Vec3 wi{0.f};
-        float pdf = 0.f;       // of the whole strategy (mixture pdf when guided)
-        bool specular = false;
-        bool transmission = false;
-        // Guided strategies only: the guide's and the BSDF's (phase function's) pdfs of wi, and
-        // the factor of the region's selection in the guide probability (confidence x share).
-        float pGuide = 0.f, pOther = 0.f, scale = 0.f;
-        // The guide's bin of wi in the region it was drawn with (GuidingField::pdf), or -1.
-        int bin = -1;
-    };
     // The guide at a vertex: its region (-1: BSDF or phase function only) and the BSDF's
     // diffuse share (1 in a medium). guideMix() finds the probability of a guided sample at
     // its first use (NEE's MIS weight or the direction sample) and keeps it, with the
@@ -207,13 +196,22 @@ private:
     // medium boundaries (interface-only surfaces), zero at any other surface.
     Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
                            PathStats& stats) const;
-    // pbrt-v3's Russian roulette after bounce 3 on the throughput scaled by the refraction
-    // eta: false if the path ends here, else true with *beta divided by the survival
-    // probability (draws a sampler dimension only when it plays).
-    bool pbrtRoulette(Spectrum* beta, float etaScale, int bounces, Sampler& sampler) const;
-    // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance).
-    float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                          const Vec3& woY) const;
+    // The state a path carries from vertex to vertex.
+    struct PathState {
+        Spectrum L{0.f}, beta{1.f};
+        Ray ray;
+        bool specularBounce = false;
+        float dirPdf = 0.f, etaScale = 1.f;
+        LightSampleContext prev;
+        PathMedium pm;
+    };
+    // The medium step of Li (scenes with media, a path in a medium): the free flight to the
+    // closest hit si (found: there is one), and at a scattering event the medium vertex (NEE,
+    // direction sampling, roulette). Surface: the flight reached the surface (or escaped);
+    // Scattered: s.ray is the next ray; End: the path ends.
+    enum class Step { Surface, Scattered, End };
+    Step mediumStep(PathState& s, bool found, const SurfaceInteraction& si, int bounces,
+                    Sampler& sampler, PathStats& stats, PathRecorder& rec) const;
 
     const Scene& scene_;
     std::unique_ptr<LightSampler> lights_;

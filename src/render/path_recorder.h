@@ -1,0 +1,166 @@
+// The guide's training from one path: the integrator reports what happens at each vertex
+// (surface arrival and scattering, medium scattering, free flights, escape) and the recorder
+// turns it into the training records of the configured scheme, handed to the field's slot:
+// - the path's returns (target=path, the default): each guided surface vertex learns the
+//   radiance its sampled direction brought back, recorded when the path ends;
+// - Eq. 1's bootstrap (target=sum|sample, and at medium vertices always): the previous guided
+//   vertex's target is Le + the learned light scattered at the next vertex, carried through
+//   delta vertices (a pending record);
+// - the selection samples of mix=learn, recorded when the path ends.
+// The only place of the training bookkeeping; the integrator decides nothing about it.
+#pragma once
+
+#include "guiding/guiding.h"
+#include "render/bsdf.h"
+#include "render/direction_sample.h"
+#include "render/interaction.h"
+#include "render/spectrum.h"
+
+namespace rlpbrt {
+
+struct GuideSettings;
+
+class PathRecorder {
+public:
+    // Records into `slot` of guide.field if it learns (GuideSettings::learn), else nothing.
+    PathRecorder(const GuideSettings& guide, int slot);
+
+    bool learning() const { return learn_; }
+    // Whether surface vertices need a region for Eq. 1's bootstrap even where the path
+    // samples no guided direction (its last direction).
+    bool bootstraps() const { return bootstrap_; }
+    // A pending Eq. 1 record waits for the next vertex's light (the path must reach it).
+    bool awaitsTarget() const { return pending_.active(); }
+
+    // A free flight through a medium weighted the throughput by `weight`.
+    void flight(const Spectrum& weight) {
+        if (pending_.active()) pending_.weight *= luminance(weight);
+    }
+    // A medium vertex at p where the field has no region: ask it to model the place.
+    void requestMedium(const Vec3& p) {
+        if (learn_) field_->requestMedium(slot_, p);
+    }
+    // A medium vertex at `region` (-1: none) sampled ds: completes the pending record with
+    // the one-sample estimate Q(p, w') phase / pdf and starts its own.
+    void mediumScattered(int region, const DirectionSample& ds);
+    // The path left the scene, where the environment's luminance is envLum.
+    void escaped(float envLum) {
+        if (learn_) flush(envLum);
+    }
+    // The path passed a surface without material that emits `emitted` (luminance).
+    void passedThrough(float emitted) {
+        if (pending_.active()) pending_.target += pending_.weight * emitted;
+    }
+    // The path reached surface vertex si (BSDF bsdf, region -1 where the field has none),
+    // which emits `emitted` toward it. Completes the pending Eq. 1 record with the light
+    // scattered at si; true if that waits for the direction sampled at si (surfaceSampled).
+    bool surfaceReached(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                        bool canGuide, int lobes, float emitted, bool lastVertex) {
+        return learn_ && pending_.active() &&
+               completePending(si, bsdf, region, canGuide, lobes, emitted, lastVertex);
+    }
+    // The direction ds was sampled at si; `deferred` is surfaceReached's answer.
+    void surfaceSampled(bool deferred, const SurfaceInteraction& si, int region,
+                        const DirectionSample& ds, float emitted) {
+        if (deferred) completeDeferred(si, region, ds, emitted);
+    }
+    // Before the throughput takes ds's weight: a selection sample of a guided vertex at
+    // sampleRegion (mix=learn), with the path's L and throughput so far.
+    void selectionVertex(int sampleRegion, const DirectionSample& ds, const Spectrum& L,
+                         const Spectrum& beta) {
+        if (!learnSelection_ || sampleRegion < 0 || numSel_ >= kMaxSelectionVertices) return;
+        sel_.v[numSel_++] = SelectionVertex{
+            sampleRegion, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
+            luminance(L), luminance(beta)};
+    }
+    // After the throughput took the direction's weight (beta): the vertex's return (it learns
+    // the light gathered from here on), and the pending record's next step (a new one at a
+    // guided vertex with Eq. 1's targets, carried through a delta vertex, else dropped).
+    // returnRegion: the region that learns the return, -1 for none.
+    void surfaceScattered(int region, int returnRegion, bool canGuide, const DirectionSample& ds,
+                          const Spectrum& weight, const Spectrum& L, const Spectrum& beta) {
+        if (returns_ && returnRegion >= 0 && numRet_ < kMaxReturnVertices)
+            ret_[numRet_++] = ReturnVertex{returnRegion, ds.bin, ds.wi, L, beta};
+        if (!learn_) return;
+        if (bootstrap_ && region >= 0 && !ds.transmission) {
+            pending_ = PendingRecord();
+            pending_.region = region;
+            pending_.w = ds.wi;
+            pending_.bin = ds.bin;
+        } else if (pending_.active() && region < 0 && !canGuide) {
+            pending_.weight *= luminance(weight);  // through a delta vertex
+        } else {
+            pending_ = PendingRecord();
+        }
+    }
+    // The path ended with radiance L: records the returns and the selection samples.
+    void finish(const Spectrum& L);
+
+private:
+    // The pending training record of the last guided vertex: its region and direction, and
+    // the target collected so far through delta vertices (weight = product of their
+    // f cos / pdf).
+    struct PendingRecord {
+        int region = -1;
+        Vec3 w{0.f};
+        int bin = -1;  // the guide's bin of w in region, or -1
+        float target = 0.f;
+        float weight = 1.f;
+        bool active() const { return region >= 0; }
+    };
+    // A guided vertex trained with the path's return (target=path): the radiance the path
+    // gathered after it, over the throughput after its direction sample, is the radiance that
+    // direction brought to it, as the estimator counts it: emission found by the direction
+    // carries its MIS weight against the vertex's next-event estimation.
+    struct ReturnVertex {
+        int region;
+        int bin;  // the guide's bin of w in region, or -1
+        Vec3 w;
+        Spectrum L;     // L when the direction was sampled (after the vertex's NEE)
+        Spectrum beta;  // throughput after the direction's weight
+    };
+    static constexpr int kMaxReturnVertices = 32;
+    // A guided vertex whose direction sample feeds the selection learning (mix=learn): the
+    // radiance the path gathers after it, over the throughput at it, is the sample's
+    // contribution F = f cos Li / pdf, so its integrand is F * pdf (known when the path ends).
+    struct SelectionVertex {
+        int region;
+        guiding::SelectionSample s;
+        float lumL;     // luminance of L when the direction was sampled
+        float lumBeta;  // luminance of the throughput at the vertex
+    };
+    static constexpr int kMaxSelectionVertices = 16;
+    // A path's selection vertices, left uninitialised until used: value-initialising all of
+    // them cost every path 48 instructions, and only mix=learn uses them.
+    union SelectionVertices {
+        SelectionVertices() {}
+        SelectionVertex v[kMaxSelectionVertices];
+    };
+
+    // Completes the pending record with `addTarget` (weighted) and records it.
+    void flush(float addTarget) {
+        if (!pending_.active()) return;
+        pending_.target += pending_.weight * addTarget;
+        field_->record(slot_, pending_.region, pending_.w, pending_.target, pending_.bin);
+        pending_ = PendingRecord();
+    }
+    bool completePending(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                         bool canGuide, int lobes, float emitted, bool lastVertex);
+    void completeDeferred(const SurfaceInteraction& si, int region, const DirectionSample& ds,
+                          float emitted);
+    // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance); -1 if it is to
+    // be estimated with the direction sampled there.
+    float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
+                          const Vec3& woY) const;
+
+    guiding::GuidingField* field_;
+    int slot_;
+    bool learn_, learnSelection_, bootstrap_, returns_, sampledTarget_;
+    PendingRecord pending_;
+    ReturnVertex ret_[kMaxReturnVertices];
+    int numRet_ = 0;
+    SelectionVertices sel_;
+    int numSel_ = 0;
+};
+
+}  // namespace rlpbrt
