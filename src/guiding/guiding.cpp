@@ -25,14 +25,9 @@ float GuidingField::policyRadiance(int region, const glm::vec3& w, int bin) cons
 
 void GuidingField::recordSelection(int, int, const SelectionSample&) {}
 
-int GuidingField::lookupMedium(const glm::vec3&) const { return -1; }
-void GuidingField::prefetch(const glm::vec3&) const {}
+void GuidingField::prefetch(const VertexQuery&) const {}
 float GuidingField::patchSize() const { return 0.f; }
 void GuidingField::setPatches(uint32_t, std::function<bool(uint32_t, glm::vec3*, glm::vec3*)>) {}
-int GuidingField::lookupPatch(uint32_t, const glm::vec3& p, const glm::vec3& n) const {
-    return lookup(p, n);
-}
-void GuidingField::prefetchPatch(uint32_t, const glm::vec3& p) const { prefetch(p); }
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
 

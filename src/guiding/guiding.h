@@ -65,46 +65,72 @@ struct SelectionSample {
     float scale = 0.f;
 };
 
-// A learned directional distribution per spatial region. lookup/sample/pdf/scattered/
-// irradianceEstimate are const and thread-safe; they read the policy frozen at the last
-// endPass() and must not run concurrently with endPass(). record() is thread-safe across
-// distinct slots.
+class GuidingField;
+class VertexGuide;
+class TrainingSlot;
+
+// What a path vertex asks the field: a surface vertex at p whose hemisphere of interest is
+// around unit normal n (the integrator passes the shading normal flipped to wo's side), or a
+// scattering vertex inside a participating medium, whose directions cover the whole sphere.
+// patch is a hint (setPatches): the surface piece the vertex lies on, or kNoPatch.
+struct VertexQuery {
+    static constexpr uint32_t kNoPatch = UINT32_MAX;
+    glm::vec3 p{0.f};
+    glm::vec3 n{0.f};
+    uint32_t patch = kNoPatch;
+    bool medium = false;
+    static VertexQuery surface(const glm::vec3& p, const glm::vec3& n,
+                               uint32_t patch = kNoPatch) {
+        return VertexQuery{p, n, patch, false};
+    }
+    static VertexQuery inMedium(const glm::vec3& p) {
+        return VertexQuery{p, glm::vec3(0.f), kNoPatch, true};
+    }
+};
+
+// A learned directional distribution per spatial region: the field learns (beginPass,
+// records through its slots, endPass), saves and reports; per vertex it answers with a region
+// (locate), which the integrator reads through a VertexGuide (sample, pdf, radiance).
+// locate/sample/pdf/scatteredEstimate/irradianceEstimate are const and thread-safe; they read
+// the policy frozen at the last endPass() and must not run concurrently with endPass().
+// record() is thread-safe across distinct slots.
 class GuidingField {
 public:
     virtual ~GuidingField();
 
-    // Region for a vertex at p whose hemisphere of interest is around unit normal n (the
-    // integrator passes the shading normal flipped to wo's side). -1 = no data: use the BSDF.
-    virtual int lookup(const glm::vec3& p, const glm::vec3& n) const = 0;
-    // A hint that lookup(p, ...) follows soon: a backend may start loading what it will read
-    // (no effect on results). Default: nothing.
-    virtual void prefetch(const glm::vec3& p) const;
-    // Surface patches (optional): the integrator may cut the scene's surfaces into small
-    // pieces named by keys in [0, count) (render/patches.h) and pass each vertex's key to
-    // lookupPatch, which a backend may answer from a memo per piece instead of a spatial
-    // search. patchSize(): the piece size the backend wants, in world units (0, the default:
-    // it uses none). setPatches(count, centre): centre(i, &p, &n) gives a point of piece i
-    // and its unit normal (either orientation; false or a zero normal: unknown); called before
-    // rendering, and centre must stay valid and thread-safe for the field's life. Default:
-    // ignored.
-    static constexpr uint32_t kNoPatch = UINT32_MAX;
+    // ---- Per vertex.
+    // The region for a vertex; -1 = no data there: use the BSDF (or the phase function). A
+    // backend that guides on surfaces only answers -1 to medium queries.
+    virtual int locate(const VertexQuery& q) const = 0;
+    // A hint that locate(q) follows soon (q.p and q.patch are set, q.n may not be yet): a
+    // backend may start loading what it will read. No effect on results. Default: nothing.
+    virtual void prefetch(const VertexQuery& q) const;
+    // The guide at a vertex.
+    VertexGuide guide(const VertexQuery& q) const;
+    // locate() for a surface vertex (with its patch) or a medium vertex.
+    int lookup(const glm::vec3& p, const glm::vec3& n) const {
+        return locate(VertexQuery::surface(p, n));
+    }
+    int lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const {
+        return locate(VertexQuery::surface(p, n, patch));
+    }
+    int lookupMedium(const glm::vec3& p) const { return locate(VertexQuery::inMedium(p)); }
+
+    // Surface patches, a hint the field may use: the integrator may cut the scene's surfaces
+    // into small pieces named by keys in [0, count) (render/patches.h) and pass each vertex's
+    // key in VertexQuery::patch, which a backend may answer from a memo per piece instead of
+    // a spatial search (where the piece's region is admissible for n). patchSize(): the piece
+    // size the backend wants, in world units (0, the default: it uses none). setPatches(count,
+    // centre): centre(i, &p, &n) gives a point of piece i and its unit normal (either
+    // orientation; false or a zero normal: unknown); called before rendering, and centre must
+    // stay valid and thread-safe for the field's life. Default: ignored.
+    static constexpr uint32_t kNoPatch = VertexQuery::kNoPatch;
     virtual float patchSize() const;
     virtual void setPatches(uint32_t count,
                             std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> centre);
-    // lookup(p, n) for a vertex on piece `patch` (kNoPatch, or no patches: lookup(p, n)
-    // itself). A backend may return the region of the piece's centre and normal where that
-    // region is admissible for n. Default: lookup(p, n).
-    virtual int lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const;
-    // prefetch() for a lookupPatch(patch, p, ...) that follows soon. Default: prefetch(p).
-    virtual void prefetchPatch(uint32_t patch, const glm::vec3& p) const;
-    // Region for a scattering vertex at p inside a participating medium, whose directions
-    // cover the whole sphere; -1 = no data there (sample the phase function). All the
-    // per-region calls below accept it. Default: -1 (the backend guides on surfaces only).
-    virtual int lookupMedium(const glm::vec3& p) const;
-    // Asks the field to model the medium around p (a medium vertex where lookupMedium found
-    // no data) from the next pass on. Thread-safe across slots, like record(). Default:
-    // ignored.
-    virtual void requestMedium(int slot, const glm::vec3& p);
+
+    // ---- The policy of a region (what VertexGuide reads). Every call accepts -1 (an
+    // invalid region) and medium regions.
     // Samples a unit world direction from the frozen policy of `region` (u places it inside
     // the stratum chosen by uStratum; all in [0,1)); *pdf is per steradian and equals
     // pdf(region, result) (> 0 for a valid region; 0 and a zero vector for an invalid one).
@@ -147,10 +173,9 @@ public:
     // region, frozen per pass like the policy, or -1 where none has been learned (the
     // integrator then uses its mix setting). Default: -1.
     virtual float selection(int region) const;
-    // Records how a direction was drawn at `region` and what it brought (SelectionSample),
-    // for learning selection(); thread-safe across slots like record(). Default: ignored.
-    virtual void recordSelection(int slot, int region, const SelectionSample& s);
 
+    // ---- Learning: through TrainingSlot, one per work item (film tile).
+    TrainingSlot slot(int index);
     // Learning: during a pass, record that from `region` the direction w received target T
     // (the radiance the direction brought back along the path, or Eq. 1's T = Le +
     // scatteredEstimate at the next vertex, or the environment radiance). `slot` is
@@ -162,10 +187,17 @@ public:
     // bin from pdf()/sample() for this region, or -1 (found from w).
     virtual void record(int slot, int region, const glm::vec3& w, float target,
                         int bin = -1) = 0;
-    // Applies the recorded targets (Eq. 1 with alpha = 1/(1+visits) by default, i.e. the
-    // batch running mean of the notes section 4, or a fixed alpha) and rebuilds the CDFs.
+    // Asks the field to model the medium around p (a medium vertex where locate found no
+    // data) from the next pass on. Thread-safe across slots, like record(). Default: ignored.
+    virtual void requestMedium(int slot, const glm::vec3& p);
+    // Records how a direction was drawn at `region` and what it brought (SelectionSample),
+    // for learning selection(); thread-safe across slots like record(). Default: ignored.
+    virtual void recordSelection(int slot, int region, const SelectionSample& s);
+    // Applies the recorded targets (a running mean per stratum: alpha = 1/(1+visits) by
+    // default, or a fixed alpha) and rebuilds the CDFs.
     virtual void endPass() = 0;
 
+    // ---- Reporting and saving.
     // Memory of the learned data in bytes (tables, CDFs, points, kd-tree; not the per-pass
     // record buffers).
     virtual size_t bytes() const = 0;
@@ -183,6 +215,70 @@ public:
     // voxel size, strata); otherwise false, *error says why, and the field is unchanged.
     virtual bool load(const std::string& path, std::string* error);
 };
+
+// The guide at one vertex: the field's region there (GuidingField::guide), and what the
+// integrator reads of it. A small value; invalid (region -1) where the field has no data.
+// bin: a direction's bin in the region, reported by sample() and pdf() (hemi and vdb: its
+// stratum), which radiance(), policyRadiance() and TrainingSlot::record() accept for the
+// same direction instead of finding it again (-1: found from w).
+class VertexGuide {
+public:
+    VertexGuide() = default;
+    VertexGuide(const GuidingField* field, int region) : field_(field), region_(region) {}
+    bool valid() const { return region_ >= 0; }
+    int region() const { return region_; }
+    // How far the region's policy is trusted, in [0, 1].
+    float confidence() const { return field_->confidence(region_); }
+    // The learned probability of choosing the guide, or -1 where none is learned.
+    float selection() const { return field_->selection(region_); }
+    glm::vec3 sample(glm::vec2 u, float uStratum, float* pdf, int* bin = nullptr) const {
+        return field_->sample(region_, u, uStratum, pdf, bin);
+    }
+    float pdf(const glm::vec3& w, int* bin = nullptr) const {
+        return field_->pdf(region_, w, bin);
+    }
+    float radiance(const glm::vec3& w, int bin = -1) const {
+        return field_->radiance(region_, w, bin);
+    }
+    float policyRadiance(const glm::vec3& w, int bin = -1) const {
+        return field_->policyRadiance(region_, w, bin);
+    }
+    float irradianceEstimate(const glm::vec3& n) const {
+        return field_->irradianceEstimate(region_, n);
+    }
+    float scatteredEstimate(const std::function<float(const glm::vec3&)>& fcos) const {
+        return field_->scatteredEstimate(region_, fcos);
+    }
+
+private:
+    const GuidingField* field_ = nullptr;
+    int region_ = -1;
+};
+
+// One work item's (film tile's) training slot of a field during a pass: records go to the
+// slot without a lock and are merged in slot order at endPass(). One thread at a time.
+class TrainingSlot {
+public:
+    TrainingSlot() = default;
+    TrainingSlot(GuidingField* field, int slot) : field_(field), slot_(slot) {}
+    // Target T (luminance) for direction w at the vertex of `guide` (GuidingField::record).
+    void record(const VertexGuide& guide, const glm::vec3& w, float target, int bin = -1) {
+        field_->record(slot_, guide.region(), w, target, bin);
+    }
+    void recordSelection(const VertexGuide& guide, const SelectionSample& s) {
+        field_->recordSelection(slot_, guide.region(), s);
+    }
+    void requestMedium(const glm::vec3& p) { field_->requestMedium(slot_, p); }
+
+private:
+    GuidingField* field_ = nullptr;
+    int slot_ = 0;
+};
+
+inline VertexGuide GuidingField::guide(const VertexQuery& q) const {
+    return VertexGuide(this, locate(q));
+}
+inline TrainingSlot GuidingField::slot(int index) { return TrainingSlot(this, index); }
 
 // The factory: the only place that names backends. "none" returns nullptr with *error empty
 // (parameters are ignored). Unknown backend or parameter, or a bad value => nullptr and a

@@ -98,7 +98,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
 
 HemiField::~HemiField() = default;
 
-int HemiField::lookup(const glm::vec3& p, const glm::vec3& n) const {
+int HemiField::lookupPoint(const glm::vec3& p, const glm::vec3& n) const {
     if (positions_.empty() || !finite3(p)) return -1;
     const float nLen = glm::length(n);
     if (!(nLen > 0.f) || !std::isfinite(nLen)) return -1;
@@ -163,7 +163,10 @@ uint32_t HemiField::fillPatch(uint32_t patch) const {
     return kNoPoint;
 }
 
-int HemiField::lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const {
+int HemiField::locate(const VertexQuery& q) const {
+    if (q.medium) return -1;
+    const uint32_t patch = q.patch;
+    const glm::vec3 &p = q.p, &n = q.n;
     if (patch < numPatches_) {
         uint32_t v = __atomic_load_n(&patchPoint_[patch], __ATOMIC_RELAXED);
         if (v == 0) {
@@ -180,7 +183,7 @@ int HemiField::lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& 
             if (region >= 0) return prefetched(region);
         }
     }
-    return lookup(p, n);
+    return lookupPoint(p, n);
 }
 
 int HemiField::prefetched(int region) const {

@@ -112,22 +112,24 @@ public:
     HemiField(const HemiField&) = delete;
     HemiField& operator=(const HemiField&) = delete;
 
-    int lookup(const glm::vec3& p, const glm::vec3& n) const override;
-    void prefetch(const glm::vec3& p) const override {
-        if (cache_ && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
-            cache_->prefetch(p);
+    // A surface vertex's region: the point kept for its patch where that is admissible for
+    // n (lookup=patch), else lookupPoint(p, n); -1 in a medium.
+    int locate(const VertexQuery& q) const override;
+    // The vertex's cell memo entry or, on a patch, the patch's memo word.
+    void prefetch(const VertexQuery& q) const override {
+        if (q.patch < numPatches_) {
+            prefetchLine(&patchPoint_[q.patch]);
+        } else if (cache_ && std::isfinite(q.p.x) && std::isfinite(q.p.y) &&
+                   std::isfinite(q.p.z)) {
+            cache_->prefetch(q.p);
+        }
     }
+    // The region of the nearest point with an admissible normal for n (through the cell
+    // memo, or the kd-tree with lookup=exact), -1 if none.
+    int lookupPoint(const glm::vec3& p, const glm::vec3& n) const;
     float patchSize() const override;
     void setPatches(uint32_t count,
                     std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> centre) override;
-    int lookupPatch(uint32_t patch, const glm::vec3& p, const glm::vec3& n) const override;
-    void prefetchPatch(uint32_t patch, const glm::vec3& p) const override {
-        if (patch < numPatches_) {
-            prefetchLine(&patchPoint_[patch]);
-        } else {
-            prefetch(p);
-        }
-    }
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
                      int* bin = nullptr) const override;
     float pdf(int region, const glm::vec3& w, int* bin = nullptr) const override;

@@ -271,7 +271,7 @@ int VdbField::voxelIndex(const glm::ivec3& ijk) const {
     return grid_->grid->tree().getValue(openvdb::Coord(ijk.x, ijk.y, ijk.z));
 }
 
-int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
+int VdbField::lookupSurface(const glm::vec3& p, const glm::vec3& n) const {
     switch (accessor_) {
     case Accessor::PerThread: {
         std::unique_ptr<ConstAccessor>& acc = grid_->accessors.local();
@@ -307,7 +307,7 @@ int VdbField::lookup(const glm::vec3& p, const glm::vec3& n) const {
     }
 }
 
-int VdbField::lookupMedium(const glm::vec3& p) const {
+int VdbField::lookupVolume(const glm::vec3& p) const {
     if (!volume_) return -1;
     const int cell = volume_->lookup(p);
     return cell < 0 ? -1 : int(table_.regions()) + cell;

@@ -71,8 +71,13 @@ public:
     VdbField(const VdbField&) = delete;
     VdbField& operator=(const VdbField&) = delete;
 
-    int lookup(const glm::vec3& p, const glm::vec3& n) const override;
-    int lookupMedium(const glm::vec3& p) const override;
+    // A surface vertex's region: the voxel's dominant normal closest to q.n within
+    // normal-angle (lookupSurface); a medium vertex's: the volume cell at q.p.
+    int locate(const VertexQuery& q) const override {
+        return q.medium ? lookupVolume(q.p) : lookupSurface(q.p, q.n);
+    }
+    int lookupSurface(const glm::vec3& p, const glm::vec3& n) const;
+    int lookupVolume(const glm::vec3& p) const;
     void requestMedium(int slot, const glm::vec3& p) override;
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
                      int* bin = nullptr) const override;

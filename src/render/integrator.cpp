@@ -183,13 +183,12 @@ constexpr float kRouletteConfidence = 0.5f;
 
 DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
                                                                 const BSDF& bsdf,
-                                                                VertexGuide& guide,
+                                                                GuideMixture& guide,
                                                                 Sampler& sampler) const {
     DirectionSample ds;
-    const int region = guide.region;
     float uc = sampler.get1D();
     Vec2 u = sampler.get2D();
-    if (region < 0) {
+    if (!guide.guide.valid()) {
         BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
         if (!bs.valid()) return ds;
         ds.f = bs.f;
@@ -205,7 +204,7 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
-        ds.wi = guide_.field->sample(region, u, uStratum, &pGuide, &ds.bin);
+        ds.wi = guide.guide.sample(u, uStratum, &pGuide, &ds.bin);
         if (!(pGuide > 0.f)) return DirectionSample();
         ds.f = bsdf.f(si.wo, ds.wi);
         pBsdf = bsdf.pdf(si.wo, ds.wi);
@@ -216,7 +215,7 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
         ds.wi = bs.wi;
         ds.f = bs.f;
         pBsdf = bs.pdf;
-        pGuide = guide_.field->pdf(region, ds.wi, &ds.bin);
+        pGuide = guide.guide.pdf(ds.wi, &ds.bin);
     }
     ds.pdf = mix * pGuide + (1.f - mix) * pBsdf;
     ds.pGuide = pGuide;
@@ -227,7 +226,7 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
 }
 
 Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf,
-                                     VertexGuide& guide, Sampler& sampler, PathStats& stats,
+                                     GuideMixture& guide, Sampler& sampler, PathStats& stats,
                                      const PathMedium* media) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
@@ -275,24 +274,22 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
 }
 
 DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
-                                                                      VertexGuide& guide,
+                                                                      GuideMixture& guide,
                                                                       Sampler& sampler) const {
     DirectionSample ds;
-    const int region = guide.region;
     const float uc = guide_.field ? sampler.get1D() : 1.f;
     const Vec2 u = sampler.get2D();
     const float mix = guideMix(guide);
     ds.scale = guide.scale;
     float pGuide = 0.f, pPhase = 0.f;
     if (uc < mix) {
-        ds.wi = guide_.field->sample(region, u, std::min(uc / mix, OneMinusEpsilon), &pGuide,
-                                     &ds.bin);
+        ds.wi = guide.guide.sample(u, std::min(uc / mix, OneMinusEpsilon), &pGuide, &ds.bin);
         if (!(pGuide > 0.f)) return DirectionSample();
         pPhase = henyeyGreenstein(glm::dot(wo, ds.wi), g);
     } else {
         ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
         if (!(pPhase > 0.f)) return DirectionSample();
-        if (mix > 0.f) pGuide = guide_.field->pdf(region, ds.wi, &ds.bin);
+        if (mix > 0.f) pGuide = guide.guide.pdf(ds.wi, &ds.bin);
     }
     ds.f = Spectrum(pPhase);
     ds.pdf = mix * pGuide + (1.f - mix) * pPhase;
@@ -303,7 +300,7 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
 }
 
 Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g,
-                                           VertexGuide& guide, const PathMedium& pm,
+                                           GuideMixture& guide, const PathMedium& pm,
                                            Sampler& sampler, PathStats& stats) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
@@ -341,19 +338,19 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     // asked to model this place otherwise).
     if (bounces >= maxDepth_) return Step::End;
     const Vec3 p = s.ray.o + ms.t * s.ray.d, wo = -s.ray.d;
-    int region = -1;
+    guiding::VertexGuide guide;
     if (guide_.field) {
-        region = guide_.field->lookupMedium(p);
-        if (region < 0) rec.requestMedium(p);
+        guide = guide_.field->guide(guiding::VertexQuery::inMedium(p));
+        if (!guide.valid()) rec.requestMedium(p);
     }
-    const int sampleRegion = guide_.mix > 0.f ? region : -1;
+    const guiding::VertexGuide sampleGuide = guide_.mix > 0.f ? guide : guiding::VertexGuide();
     ++stats.vertices;
-    VertexGuide vertexGuide{sampleRegion, 1.f};
+    GuideMixture vertexGuide{sampleGuide, 1.f};
     s.L += s.beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, s.pm, sampler, stats);
     DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, sampler);
-    rec.mediumScattered(region, ds);
+    rec.mediumScattered(guide, ds);
     if (!(ds.pdf > 0.f)) return Step::End;
-    rec.selectionVertex(sampleRegion, ds, s.L, s.beta);
+    rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
     s.beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
     s.dirPdf = ds.pdf;
     s.specularBounce = false;
@@ -399,10 +396,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const bool wantsRegion = field && (!lastDirection || rec.bootstraps());
         // The lookup below reads a table entry for si.p: start loading it (a cache miss
         // otherwise; the material evaluation runs in between).
-        uint32_t patch = SurfacePatches::kNone;
+        guiding::VertexQuery query;
         if (found && wantsRegion) {
-            if (guide_.patches) patch = guide_.patches->key(si);
-            field->prefetchPatch(patch, si.p);
+            query.p = si.p;
+            if (guide_.patches) query.patch = guide_.patches->key(si);
+            field->prefetch(query);
         }
 
         // Media: a free flight to the hit; a scattering event is a medium vertex.
@@ -467,16 +465,16 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
         const BSDF::LobeCounts lobes = bsdf.lobeCounts();
         const bool canGuide = field && guidable(lobes);
-        int region = -1;
+        guiding::VertexGuide guide;
         if (canGuide && wantsRegion) {
-            Vec3 nFacing = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
-            region = field->lookupPatch(patch, si.p, nFacing);
+            query.n = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
+            guide = field->guide(query);
         }
         const bool lastVertex = bounces >= maxDepth_;
         const float share =
-            region >= 0 && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
-        const int sampleRegion = share > 0.f ? region : -1;
-        VertexGuide vertexGuide{sampleRegion, share};
+            guide.valid() && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
+        const guiding::VertexGuide sampleGuide = share > 0.f ? guide : guiding::VertexGuide();
+        GuideMixture vertexGuide{sampleGuide, share};
 
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
@@ -488,20 +486,20 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         // Training: the previous guided vertex's Eq. 1 target, from the light found here.
         const bool deferTarget =
-            rec.surfaceReached(si, bsdf, region, canGuide, lobes.all, emitted, lastVertex);
+            rec.surfaceReached(si, bsdf, guide, canGuide, lobes.all, emitted, lastVertex);
         if (lastVertex) break;
 
         // The next direction (the guiding seam), and what the guide learns from it.
         DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
-        rec.surfaceSampled(deferTarget, si, region, ds, emitted);
+        rec.surfaceSampled(deferTarget, si, guide, ds, emitted);
         if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
-        rec.selectionVertex(sampleRegion, ds, s.L, s.beta);
+        rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
         const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
         s.beta *= weight;
         s.dirPdf = ds.pdf;
         s.specularBounce = ds.specular;
-        rec.surfaceScattered(region, ds.transmission || lastDirection ? -1 : region, canGuide,
-                             ds, weight, s.L, s.beta);
+        rec.surfaceScattered(guide, !ds.transmission && !lastDirection, canGuide, ds, weight,
+                             s.L, s.beta);
 
         // The next ray.
         if (ds.specular && ds.transmission) {
@@ -518,10 +516,10 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // Russian roulette: from the second vertex on, on the expected contribution where
         // the guide knows it; else pbrt-v3's.
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
-            sampleRegion >= 0 && !ds.transmission &&
+            sampleGuide.valid() && !ds.transmission &&
             guideConfidence(vertexGuide) >= kRouletteConfidence) {
             const float expected =
-                luminance(s.beta) * field->policyRadiance(sampleRegion, ds.wi, ds.bin);
+                luminance(s.beta) * sampleGuide.policyRadiance(ds.wi, ds.bin);
             if (!adjointRoulette(&s.beta, expected, guide_.rouletteWindow * pixelEstimate,
                                  kMinSurvival, sampler))
                 break;

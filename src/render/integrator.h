@@ -128,49 +128,48 @@ public:
     bool wantsPixelEstimate() const { return guide_.field && guide_.adjointRoulette; }
 
 private:
-    // The guide at a vertex: its region (-1: BSDF or phase function only) and the BSDF's
-    // diffuse share (1 in a medium). guideMix() finds the probability of a guided sample at
-    // its first use (NEE's MIS weight or the direction sample) and keeps it, with the
-    // region's confidence, for the other uses (and the roulette): the confidence is read
-    // late, so that the lookup's prefetch of its cache line has landed, and once. Sampling
-    // and pdf evaluation thus agree to the bit.
-    struct VertexGuide {
-        int region = -1;
+    // The guide at a vertex mixed with its BSDF or phase function: the field's guide there
+    // (invalid: BSDF or phase function only) and the BSDF's diffuse share (1 in a medium).
+    // guideMix() finds the probability of a guided sample at its first use (NEE's MIS weight
+    // or the direction sample) and keeps it, with the region's confidence, for the other uses
+    // (and the roulette): the confidence is read late, so that the lookup's prefetch of its
+    // cache line has landed, and once. Sampling and pdf evaluation thus agree to the bit.
+    struct GuideMixture {
+        guiding::VertexGuide guide;
         float share = 0.f;
         float mix = -1.f;         // the guide probability: selection x scale, once found
         float confidence = 0.f;   // the region's
         float scale = 0.f;        // confidence x share
     };
-    float guideMix(VertexGuide& g) const {
+    float guideMix(GuideMixture& g) const {
         if (g.mix < 0.f) {
             g.mix = 0.f;
-            if (g.region >= 0) {
-                g.confidence = guide_.field->confidence(g.region);
+            if (g.guide.valid()) {
+                g.confidence = g.guide.confidence();
                 g.scale = g.confidence * g.share;
-                g.mix = regionSelection(g.region) * g.scale;
+                g.mix = guideSelection(g.guide) * g.scale;
             }
         }
         return g.mix;
     }
     // The pdf of a vertex's direction sampling for wi: the guide mixed with the BSDF or phase
     // function, whose pdf of wi is otherPdf (otherPdf alone without a guided share).
-    float mixturePdf(VertexGuide& g, const Vec3& wi, float otherPdf) const {
-        if (g.region < 0) return otherPdf;
+    float mixturePdf(GuideMixture& g, const Vec3& wi, float otherPdf) const {
+        if (!g.guide.valid()) return otherPdf;
         const float mix = guideMix(g);
-        return mix > 0.f ? mix * guide_.field->pdf(g.region, wi) + (1.f - mix) * otherPdf
-                         : otherPdf;
+        return mix > 0.f ? mix * g.guide.pdf(wi) + (1.f - mix) * otherPdf : otherPdf;
     }
-    float guideConfidence(VertexGuide& g) const {
+    float guideConfidence(GuideMixture& g) const {
         guideMix(g);
         return g.confidence;
     }
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
-                                    VertexGuide& guide, Sampler& sampler) const;
-    // The selection probability of a region: learned (mix=learn, where the field has one) or
-    // the mix setting.
-    float regionSelection(int region) const {
+                                    GuideMixture& guide, Sampler& sampler) const;
+    // The selection probability of a vertex's guide: learned (mix=learn, where the field has
+    // one) or the mix setting.
+    float guideSelection(const guiding::VertexGuide& guide) const {
         if (guide_.learnMix) {
-            const float s = guide_.field->selection(region);
+            const float s = guide.selection();
             if (s >= 0.f) return s;
         }
         return guide_.mix;
@@ -180,17 +179,17 @@ private:
         int medium = -1;
         Rng* rng = nullptr;
     };
-    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, VertexGuide& guide,
+    Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, GuideMixture& guide,
                          Sampler& sampler, PathStats& stats,
                          const PathMedium* media = nullptr) const;
     // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
     // against the vertex's direction sampling (phase, or the guide mixed with it at a region).
-    Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, VertexGuide& guide,
+    Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, GuideMixture& guide,
                                const PathMedium& pm, Sampler& sampler, PathStats& stats) const;
     // The direction-sampling seam at a medium vertex: the phase function, or at a region the
     // guide with probability guideMix, mixed with it (f = the phase value; one 1D dimension
     // more when a field is set); mixturePdf gives that strategy's pdf.
-    DirectionSample sampleMediumDirection(const Vec3& wo, float g, VertexGuide& guide,
+    DirectionSample sampleMediumDirection(const Vec3& wo, float g, GuideMixture& guide,
                                           Sampler& sampler) const;
     // Transmittance of the segment o + t d, t in (0, tMax), starting in `medium`: through
     // medium boundaries (interface-only surfaces), zero at any other surface.

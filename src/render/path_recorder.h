@@ -38,11 +38,11 @@ public:
     }
     // A medium vertex at p where the field has no region: ask it to model the place.
     void requestMedium(const Vec3& p) {
-        if (learn_) field_->requestMedium(slot_, p);
+        if (learn_) slot_.requestMedium(p);
     }
-    // A medium vertex at `region` (-1: none) sampled ds: completes the pending record with
-    // the one-sample estimate Q(p, w') phase / pdf and starts its own.
-    void mediumScattered(int region, const DirectionSample& ds);
+    // A medium vertex with the field's `guide` there (invalid: none) sampled ds: completes
+    // the pending record with the one-sample estimate Q(p, w') phase / pdf and starts its own.
+    void mediumScattered(const guiding::VertexGuide& guide, const DirectionSample& ds);
     // The path left the scene, where the environment's luminance is envLum.
     void escaped(float envLum) {
         if (learn_) flush(envLum);
@@ -51,43 +51,48 @@ public:
     void passedThrough(float emitted) {
         if (pending_.active()) pending_.target += pending_.weight * emitted;
     }
-    // The path reached surface vertex si (BSDF bsdf, region -1 where the field has none),
+    // The path reached surface vertex si (BSDF bsdf, the field's guide there, invalid where
+    // it has none),
     // which emits `emitted` toward it. Completes the pending Eq. 1 record with the light
     // scattered at si; true if that waits for the direction sampled at si (surfaceSampled).
-    bool surfaceReached(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                        bool canGuide, int lobes, float emitted, bool lastVertex) {
+    bool surfaceReached(const SurfaceInteraction& si, const BSDF& bsdf,
+                        const guiding::VertexGuide& guide, bool canGuide, int lobes,
+                        float emitted, bool lastVertex) {
         return learn_ && pending_.active() &&
-               completePending(si, bsdf, region, canGuide, lobes, emitted, lastVertex);
+               completePending(si, bsdf, guide, canGuide, lobes, emitted, lastVertex);
     }
     // The direction ds was sampled at si; `deferred` is surfaceReached's answer.
-    void surfaceSampled(bool deferred, const SurfaceInteraction& si, int region,
-                        const DirectionSample& ds, float emitted) {
-        if (deferred) completeDeferred(si, region, ds, emitted);
+    void surfaceSampled(bool deferred, const SurfaceInteraction& si,
+                        const guiding::VertexGuide& guide, const DirectionSample& ds,
+                        float emitted) {
+        if (deferred) completeDeferred(si, guide, ds, emitted);
     }
     // Before the throughput takes ds's weight: a selection sample of a guided vertex at
-    // sampleRegion (mix=learn), with the path's L and throughput so far.
-    void selectionVertex(int sampleRegion, const DirectionSample& ds, const Spectrum& L,
-                         const Spectrum& beta) {
-        if (!learnSelection_ || sampleRegion < 0 || numSel_ >= kMaxSelectionVertices) return;
+    // sampleGuide (mix=learn), with the path's L and throughput so far.
+    void selectionVertex(const guiding::VertexGuide& sampleGuide, const DirectionSample& ds,
+                         const Spectrum& L, const Spectrum& beta) {
+        if (!learnSelection_ || !sampleGuide.valid() || numSel_ >= kMaxSelectionVertices)
+            return;
         sel_.v[numSel_++] = SelectionVertex{
-            sampleRegion, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
+            sampleGuide, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
             luminance(L), luminance(beta)};
     }
     // After the throughput took the direction's weight (beta): the vertex's return (it learns
     // the light gathered from here on), and the pending record's next step (a new one at a
     // guided vertex with Eq. 1's targets, carried through a delta vertex, else dropped).
-    // returnRegion: the region that learns the return, -1 for none.
-    void surfaceScattered(int region, int returnRegion, bool canGuide, const DirectionSample& ds,
-                          const Spectrum& weight, const Spectrum& L, const Spectrum& beta) {
-        if (returns_ && returnRegion >= 0 && numRet_ < kMaxReturnVertices)
-            ret_[numRet_++] = ReturnVertex{returnRegion, ds.bin, ds.wi, L, beta};
+    // learnsReturn: whether the vertex's guide learns the return.
+    void surfaceScattered(const guiding::VertexGuide& guide, bool learnsReturn, bool canGuide,
+                          const DirectionSample& ds, const Spectrum& weight, const Spectrum& L,
+                          const Spectrum& beta) {
+        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices)
+            ret_.v[numRet_++] = ReturnVertex{guide, ds.bin, ds.wi, L, beta};
         if (!learn_) return;
-        if (bootstrap_ && region >= 0 && !ds.transmission) {
+        if (bootstrap_ && guide.valid() && !ds.transmission) {
             pending_ = PendingRecord();
-            pending_.region = region;
+            pending_.guide = guide;
             pending_.w = ds.wi;
             pending_.bin = ds.bin;
-        } else if (pending_.active() && region < 0 && !canGuide) {
+        } else if (pending_.active() && !guide.valid() && !canGuide) {
             pending_.weight *= luminance(weight);  // through a delta vertex
         } else {
             pending_ = PendingRecord();
@@ -101,20 +106,20 @@ private:
     // the target collected so far through delta vertices (weight = product of their
     // f cos / pdf).
     struct PendingRecord {
-        int region = -1;
+        guiding::VertexGuide guide;
         Vec3 w{0.f};
-        int bin = -1;  // the guide's bin of w in region, or -1
+        int bin = -1;  // the guide's bin of w, or -1
         float target = 0.f;
         float weight = 1.f;
-        bool active() const { return region >= 0; }
+        bool active() const { return guide.valid(); }
     };
     // A guided vertex trained with the path's return (target=path): the radiance the path
     // gathered after it, over the throughput after its direction sample, is the radiance that
     // direction brought to it, as the estimator counts it: emission found by the direction
     // carries its MIS weight against the vertex's next-event estimation.
     struct ReturnVertex {
-        int region;
-        int bin;  // the guide's bin of w in region, or -1
+        guiding::VertexGuide guide;
+        int bin;  // the guide's bin of w, or -1
         Vec3 w;
         Spectrum L;     // L when the direction was sampled (after the vertex's NEE)
         Spectrum beta;  // throughput after the direction's weight
@@ -124,14 +129,19 @@ private:
     // radiance the path gathers after it, over the throughput at it, is the sample's
     // contribution F = f cos Li / pdf, so its integrand is F * pdf (known when the path ends).
     struct SelectionVertex {
-        int region;
+        guiding::VertexGuide guide;
         guiding::SelectionSample s;
         float lumL;     // luminance of L when the direction was sampled
         float lumBeta;  // luminance of the throughput at the vertex
     };
     static constexpr int kMaxSelectionVertices = 16;
-    // A path's selection vertices, left uninitialised until used: value-initialising all of
-    // them cost every path 48 instructions, and only mix=learn uses them.
+    // A path's return and selection vertices, left uninitialised until used (their guides
+    // have default values): initialising the arrays cost every path 48 (selections) to 170
+    // (returns) instructions.
+    union ReturnVertices {
+        ReturnVertices() {}
+        ReturnVertex v[kMaxReturnVertices];
+    };
     union SelectionVertices {
         SelectionVertices() {}
         SelectionVertex v[kMaxSelectionVertices];
@@ -141,23 +151,23 @@ private:
     void flush(float addTarget) {
         if (!pending_.active()) return;
         pending_.target += pending_.weight * addTarget;
-        field_->record(slot_, pending_.region, pending_.w, pending_.target, pending_.bin);
+        slot_.record(pending_.guide, pending_.w, pending_.target, pending_.bin);
         pending_ = PendingRecord();
     }
-    bool completePending(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                         bool canGuide, int lobes, float emitted, bool lastVertex);
-    void completeDeferred(const SurfaceInteraction& si, int region, const DirectionSample& ds,
-                          float emitted);
+    bool completePending(const SurfaceInteraction& si, const BSDF& bsdf,
+                         const guiding::VertexGuide& guide, bool canGuide, int lobes,
+                         float emitted, bool lastVertex);
+    void completeDeferred(const SurfaceInteraction& si, const guiding::VertexGuide& guide,
+                          const DirectionSample& ds, float emitted);
     // The bootstrap term of Eq. 1 at a vertex with guiding data (luminance); -1 if it is to
     // be estimated with the direction sampled there.
-    float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf, int region,
-                          const Vec3& woY) const;
+    float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf,
+                          const guiding::VertexGuide& guide, const Vec3& woY) const;
 
-    guiding::GuidingField* field_;
-    int slot_;
+    guiding::TrainingSlot slot_;
     bool learn_, learnSelection_, bootstrap_, returns_, sampledTarget_;
     PendingRecord pending_;
-    ReturnVertex ret_[kMaxReturnVertices];
+    ReturnVertices ret_;
     int numRet_ = 0;
     SelectionVertices sel_;
     int numSel_ = 0;

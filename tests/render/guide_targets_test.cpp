@@ -36,9 +36,9 @@ public:
         int bin;  // as passed to record()
     };
     static int binOf(const glm::vec3& w) { return w.z > 0.5f ? 0 : w.z > 0.f ? 1 : -1; }
-    int lookup(const glm::vec3&, const glm::vec3& n) const override {
+    int locate(const guiding::VertexQuery& q) const override {
         ++lookups;
-        return n.z > 0.f ? 0 : -1;
+        return !q.medium && q.n.z > 0.f ? 0 : -1;
     }
     glm::vec3 sample(int, glm::vec2 u, float, float* pdf, int* bin) const override {
         ++samples;
