@@ -5,7 +5,7 @@
 namespace rlpbrt::guiding {
 
 StrataLayout::StrataLayout(int cols, int rows)
-    : cols_(cols), rows_(rows), density_(static_cast<float>(cols * rows / (2.0 * kPi))) {
+    : cols_(cols), rows_(rows), density_(static_cast<float>(cols * rows / (2.0 * PiDouble))) {
     octantShift_ = cols == 2 ? 2 : cols == 4 ? 1 : (cols == 8 || cols == 16) ? 0 : -1;
     centres_.resize(static_cast<size_t>(cols) * static_cast<size_t>(rows));
     for (int row = 0; row < rows; ++row) {
@@ -13,7 +13,7 @@ StrataLayout::StrataLayout(int cols, int rows)
         double z = (row + 0.5) / rows;
         double r = std::sqrt(std::max(0.0, 1.0 - z * z));
         for (int col = 0; col < cols; ++col) {
-            double phi = 2.0 * kPi * (col + 0.5) / cols;
+            double phi = 2.0 * PiDouble * (col + 0.5) / cols;
             centres_[static_cast<size_t>(row * cols + col)] =
                 glm::vec3(static_cast<float>(r * std::cos(phi)),
                           static_cast<float>(r * std::sin(phi)), static_cast<float>(z));

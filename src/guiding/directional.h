@@ -1,4 +1,4 @@
-// Directional building blocks of the guiding layer: an orthonormal frame around a normal, the
+// Directional building blocks of the guiding layer (with util/math.h's Frame): the
 // equal-area stratification of the hemisphere (cylindrical equal-area map) and piecewise-
 // constant CDFs over the strata. Standard library and GLM only.
 #pragma once
@@ -11,31 +11,10 @@
 
 #include <glm/glm.hpp>
 
+#include "util/math.h"
+#include "util/sequence.h"
+
 namespace rlpbrt::guiding {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr float kTwoPiF = 6.28318530717958647692f;
-
-// Orthonormal basis with z along a unit normal (Duff et al. 2017, "Building an Orthonormal
-// Basis, Revisited"); same construction as the render layer's Frame, kept here so the guiding
-// layer does not depend on src/render/.
-struct HemiFrame {
-    glm::vec3 s, t, n;
-    // Frame around the unit vector n (local +z = n).
-    static HemiFrame fromZ(const glm::vec3& n) {
-        float sign = std::copysign(1.f, n.z);
-        float a = -1.f / (sign + n.z);
-        float b = n.x * n.y * a;
-        return HemiFrame{glm::vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x),
-                         glm::vec3(b, sign + n.y * n.y * a, -n.y), n};
-    }
-    // World vector -> local coordinates (z along n).
-    glm::vec3 toLocal(const glm::vec3& v) const {
-        return glm::vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n));
-    }
-    // Local coordinates -> world vector.
-    glm::vec3 toWorld(const glm::vec3& v) const { return s * v.x + t * v.y + n * v.z; }
-};
 
 // w scaled to unit length, for the strata lookups: false for a zero, NaN or infinite w. A w
 // that is unit to within 1e-5 in squared length (every direction the integrator passes) is
@@ -71,7 +50,7 @@ inline float azimuth(float x, float y) {
     r *= a;
     if (ay > ax) r = 1.5707963267948966f - r;
     if (x < 0.f) r = 3.14159265358979f - r;
-    if (y < 0.f) r = kTwoPiF - r;
+    if (y < 0.f) r = TwoPi - r;
     return r;
 }
 
@@ -88,7 +67,7 @@ public:
     int rows() const { return rows_; }
     int count() const { return cols_ * rows_; }
     // Solid angle of one stratum in steradians: 2 pi / count().
-    double stratumSolidAngle() const { return 2.0 * kPi / count(); }
+    double stratumSolidAngle() const { return 2.0 * PiDouble / count(); }
     // Its inverse as a float, count() / (2 pi): a stratum's density per steradian is its
     // probability times this (computed once: the pdfs would divide on every call).
     float density() const { return density_; }
@@ -125,7 +104,7 @@ public:
         } else if (cols_ > 1) {
             float phi = azimuth(local.x, local.y);
             if (!(phi >= 0.f)) return -1;  // NaN components
-            col = static_cast<int>(phi * (static_cast<float>(cols_) / kTwoPiF));
+            col = static_cast<int>(phi * (static_cast<float>(cols_) / TwoPi));
             col = col < 0 ? 0 : (col < cols_ - 1 ? col : cols_ - 1);
         }
         return row * cols_ + col;
@@ -138,7 +117,7 @@ public:
         float z = (static_cast<float>(row) + u.x) / static_cast<float>(rows_);
         z = z < 1.f ? z : 1.f;
         float r = std::sqrt(std::max(0.f, 1.f - z * z));
-        float phi = kTwoPiF * (static_cast<float>(col) + u.y) / static_cast<float>(cols_);
+        float phi = TwoPi * (static_cast<float>(col) + u.y) / static_cast<float>(cols_);
         return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
     }
 
@@ -177,20 +156,6 @@ private:
     int octantShift_ = -1;
     std::vector<glm::vec3> centres_;
 };
-
-// Radical inverse of i in a prime base: the Halton sequence's coordinate, in [0, 1). Used to
-// draw the surface samples that place regions.
-inline float radicalInverse(uint64_t i, uint64_t base) {
-    const double invBase = 1.0 / static_cast<double>(base);
-    double inv = invBase, value = 0.0;
-    while (i > 0) {
-        uint64_t next = i / base;
-        value += static_cast<double>(i - next * base) * inv;
-        inv *= invBase;
-        i = next;
-    }
-    return std::min(static_cast<float>(value), 0x1.fffffep-1f);
-}
 
 // Builds the CDF of one stratum table: P_j = (1 - epsilon) q_j / sum(q) + epsilon / n, summed
 // in double; uniform if sum(q) is 0 or not finite. cdf has n + 1 entries, cdf[0] = 0 and

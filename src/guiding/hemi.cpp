@@ -33,7 +33,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
       sceneMax_(scene.boundsMax),
       sceneArea_(scene.totalArea),
       strata_(params.cols * params.rows),
-      cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * kPi / 180.0))) {
+      cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * PiDouble / 180.0))) {
     // Uniform points over the surface: a Halton sequence through the scene's area sampler.
     // Failed draws and non-finite or zero normals are skipped, within a bounded budget.
     positions_.reserve(params.points);
@@ -84,7 +84,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
 
     const size_t regions = positions_.size() * 2;
     frames_.resize(regions);
-    for (size_t r = 0; r < regions; ++r) frames_[r].frame = HemiFrame::fromZ(regionNormal(int(r)));
+    for (size_t r = 0; r < regions; ++r) frames_[r].frame = Frame::fromZ(regionNormal(int(r)));
     if (params.smooth > 0.0)
         table_.setSmoothing(layout_.quadtree(), params.smooth);
     table_.reset(regions, strata_, params.init, policy(), /*lazy=*/true);
@@ -244,7 +244,7 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfO
 float HemiField::scatteredEstimate(int region,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (!validRegion(region)) return 0.f;
-    const HemiFrame& frame = frames_[size_t(region)].frame;
+    const Frame& frame = frames_[size_t(region)].frame;
     const float* q = table_.estimates(size_t(region));
     double acc = 0.0;
     for (int j = 0; j < strata_; ++j) {
@@ -314,7 +314,7 @@ void HemiField::updateRegion(int region, const double* q) {
                              : 0.0;
     rf.policyScale = float(std::min(scale, double(FLT_MAX)));
     const double sa = layout_.stratumSolidAngle();
-    const HemiFrame& f = rf.frame;
+    const Frame& f = rf.frame;
     glm::vec3 world;
     for (int i = 0; i < 3; ++i) {
         double v = (double(f.s[i]) * m[0] + double(f.t[i]) * m[1] + double(f.n[i]) * m[2]) * sa;

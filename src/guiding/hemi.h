@@ -262,7 +262,7 @@ private:
     // sum_j Q_j w_j (2pi/n) over the world stratum centres w_j, its confidence, and the scale
     // that turns a stratum's probability back into its Q (policyRadiance).
     struct alignas(64) RegionFrame {
-        HemiFrame frame;
+        Frame frame;
         glm::vec3 moment{0.f};
         float confidence = 0.f;   // visits / (visits + warmup * strata), frozen per pass
         float policyScale = 0.f;  // sum_j Q_j cos_j / (1 - epsilon); 0 for a uniform CDF

@@ -74,7 +74,7 @@ double vdbEstimatedBytes(const VdbParams& params, const SceneInfo& scene) {
     const double regionsPerVoxel = params.sphere ? 1.0 : 2.0 * std::min(params.normals, 2);
     const double perRegion =
         StrataTable::regionBytes(params.cols * params.rows * (params.sphere ? 2 : 1)) +
-        sizeof(HemiFrame);
+        sizeof(Frame);
     // Per voxel: normals, offsets and about 8 bytes of OpenVDB tree (leaf values and masks).
     return voxels * (regionsPerVoxel * (perRegion + sizeof(int)) + 2 * sizeof(glm::vec3) + 12.0);
 }
@@ -94,7 +94,7 @@ VdbField::VdbField(const VdbParams& params, const SceneInfo& scene)
       invVoxel_(float(1.0 / voxelSize_)),
       origin_(scene.boundsMin),
       grid_(std::make_unique<Grid>()),
-      cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * kPi / 180.0))) {
+      cosMaxAngle_(static_cast<float>(std::cos(params.normalAngleDeg * PiDouble / 180.0))) {
     openvdb::initialize();
     const uint64_t wanted = vdbPointCount(params, scene, voxelSize_);
     openvdb::Int32Grid::Ptr grid = openvdb::Int32Grid::create(-1);
@@ -212,10 +212,10 @@ void VdbField::buildFrames() {
     for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
         for (uint32_t k = clusterStart_[v]; k < clusterStart_[v + 1]; ++k) {
             const glm::vec3& n = clusterNormals_[k];
-            frames_.push_back(HemiFrame::fromZ(n));
+            frames_.push_back(Frame::fromZ(n));
             regionVoxel_.push_back(int(v));
             if (!params_.sphere) {
-                frames_.push_back(HemiFrame::fromZ(-n));
+                frames_.push_back(Frame::fromZ(-n));
                 regionVoxel_.push_back(int(v));
             }
         }
@@ -479,7 +479,7 @@ size_t VdbField::gridBytes() const { return size_t(grid_->grid->memUsage()); }
 size_t VdbField::bytes() const {
     return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
            clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
-           frames_.capacity() * sizeof(HemiFrame) + confidence_.capacity() * sizeof(float) +
+           frames_.capacity() * sizeof(Frame) + confidence_.capacity() * sizeof(float) +
            3 * centreX_.capacity() * sizeof(float) + (volume_ ? volume_->bytes() : 0);
 }
 

@@ -115,7 +115,7 @@ public:
     // Voxel of a region and the region's frame (z = one of the voxel's dominant normals, or
     // its opposite for the second hemisphere).
     int regionVoxel(int region) const { return regionVoxel_[size_t(region)]; }
-    const HemiFrame& regionFrame(int region) const { return frames_[size_t(region)]; }
+    const Frame& regionFrame(int region) const { return frames_[size_t(region)]; }
     // Integer coordinates of the voxel containing p (floor((p - origin) / voxelSize)).
     glm::ivec3 voxelCoord(const glm::vec3& p) const;
     // Index stored in the grid at a voxel, -1 if inactive.
@@ -178,7 +178,7 @@ private:
     std::vector<uint32_t> clusterStart_;
     std::vector<glm::vec3> clusterNormals_;  // unit dominant normal per cluster
     std::vector<int> regionVoxel_;          // per region
-    std::vector<HemiFrame> frames_;         // per region
+    std::vector<Frame> frames_;         // per region
     // Per region: visits / (visits + warmup * strata), refreshed with each CDF build (the
     // policy builder is const, called concurrently for distinct regions).
     mutable std::vector<float> confidence_;

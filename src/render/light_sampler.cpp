@@ -2,23 +2,18 @@
 
 #include <algorithm>
 
+#include "util/sequence.h"
+
 namespace rlpbrt {
 
 LightSampler::~LightSampler() = default;
 
 namespace {
 
-// Radical inverse of i in a prime base (Halton points inside a voxel).
-float radicalInverse(int baseIndex, uint32_t i) {
+// Radical inverse of i in the baseIndex-th prime (Halton points inside a voxel).
+float haltonCoordinate(int baseIndex, uint32_t i) {
     static const uint32_t primes[] = {2, 3, 5, 7, 11};
-    const uint32_t base = primes[baseIndex];
-    double inv = 1.0 / base, f = inv, r = 0.0;
-    while (i > 0) {
-        r += f * (i % base);
-        i /= base;
-        f *= inv;
-    }
-    return std::min(float(r), OneMinusEpsilon);
+    return radicalInverse(i, primes[baseIndex]);
 }
 
 class TableLightSampler : public LightSampler {
@@ -76,7 +71,7 @@ float* SpatialLightSampler::compute(int ix, int iy, int iz) const {
         (lights_[l]->approxContribution(lo) >= 0.f ? approxLights : sampledLights)
             .push_back(int(l));
     auto point = [&](uint32_t i) {
-        Vec3 t(radicalInverse(0, i), radicalInverse(1, i), radicalInverse(2, i));
+        Vec3 t(haltonCoordinate(0, i), haltonCoordinate(1, i), haltonCoordinate(2, i));
         return lo + t * (hi - lo);
     };
     for (uint32_t i = 0; i < kApproxSamples && !approxLights.empty(); ++i) {
@@ -88,7 +83,7 @@ float* SpatialLightSampler::compute(int ix, int iy, int iz) const {
     }
     for (uint32_t i = 0; i < kSamples && !sampledLights.empty(); ++i) {
         LightSampleContext ctx{point(i), Vec3(0.f)};
-        Vec2 u(radicalInverse(3, i), radicalInverse(4, i));
+        Vec2 u(haltonCoordinate(3, i), haltonCoordinate(4, i));
         for (int l : sampledLights) {
             LightSample ls;
             if (lights_[size_t(l)]->sampleLi(ctx, u, &ls) && ls.pdf > 0.f) {

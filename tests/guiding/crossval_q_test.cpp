@@ -86,7 +86,7 @@ TEST(GuideCrossValidation, HemiAndVdbLearnTheSameQ) {
         ASSERT_GE(rv, 0);
         for (int j = 0; j < 16; ++j) {
             // Centre of hemi's stratum j, and the same direction in vdb's strata.
-            const glm::vec3 w = HemiFrame::fromZ(h->regionNormal(rh)).toWorld(h->layout().centre(j));
+            const glm::vec3 w = Frame::fromZ(h->regionNormal(rh)).toWorld(h->layout().centre(j));
             const Cell& a = hc[{rh, j}];
             const Cell& b = vc[{rv, v->stratumOf(rv, w)}];
             ASSERT_GT(a.n, 30);

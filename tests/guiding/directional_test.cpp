@@ -69,7 +69,7 @@ TEST(StrataLayout, OctantColumnsMatchTheAzimuth) {
             const int j = layout.stratumOf(w);
             ASSERT_GE(j, 0);
             const double phi = std::atan2(double(w.y), double(w.x));
-            const double turns = (phi < 0.0 ? phi + 2.0 * kPi : phi) / (2.0 * kPi) * cols;
+            const double turns = (phi < 0.0 ? phi + 2.0 * PiDouble : phi) / (2.0 * PiDouble) * cols;
             if (std::abs(turns - std::round(turns)) < 1e-5) continue;  // on an edge
             ASSERT_EQ(j % cols, int(turns)) << cols << " cols, w = " << w.x << " " << w.y;
             ++checked;
@@ -153,13 +153,13 @@ TEST(StrataCdf, SampleFrequenciesMatchProbabilities) {
     EXPECT_TRUE(r.passed) << r.message;
 }
 
-TEST(HemiFrame, OrthonormalAndInverse) {
+TEST(Frame, OrthonormalAndInverse) {
     std::mt19937_64 rng(5);
     for (int i = 0; i < 1000; ++i) {
         glm::vec3 n = gaussianDirection(rng);
         if (i == 0) n = glm::vec3(0, 0, -1);
         if (i == 1) n = glm::vec3(0, 0, 1);
-        HemiFrame f = HemiFrame::fromZ(n);
+        Frame f = Frame::fromZ(n);
         EXPECT_NEAR(glm::dot(f.s, f.t), 0.f, 1e-5f);
         EXPECT_NEAR(glm::dot(f.s, f.n), 0.f, 1e-5f);
         EXPECT_NEAR(glm::dot(f.t, f.n), 0.f, 1e-5f);

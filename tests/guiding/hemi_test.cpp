@@ -32,7 +32,7 @@ std::unique_ptr<HemiField> makeHemi(const SceneInfo& scene,
 
 // World direction of stratum j's centre in a region.
 glm::vec3 strataCentre(const HemiField& f, int region, int j) {
-    return HemiFrame::fromZ(f.regionNormal(region)).toWorld(f.layout().centre(j));
+    return Frame::fromZ(f.regionNormal(region)).toWorld(f.layout().centre(j));
 }
 
 // Sum over strata of pdf(centre) * stratum solid angle: the pdf's integral over the sphere
@@ -68,7 +68,7 @@ chi2::SphereResult sphereTest(const GuidingField& f, int region, uint64_t seed,
 chi2::Result strataTest(const HemiField& f, int region, uint64_t seed, int samples) {
     const StrataLayout& layout = f.layout();
     const int n = layout.count();
-    const HemiFrame frame = HemiFrame::fromZ(f.regionNormal(region));
+    const Frame frame = Frame::fromZ(f.regionNormal(region));
     std::vector<double> observed(size_t(4 * n + 1), 0.0), expected(size_t(4 * n + 1), 0.0);
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<float> uni(0.f, 1.f);
@@ -414,7 +414,7 @@ TEST(HemiField, CosineProductPolicyMatchesPdf) {
         glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0)
                                                                         : glm::vec3(0, 1, 0)));
         float top = f->pdf(region, n), grazing = f->pdf(region, glm::normalize(t + 0.02f * n));
-        EXPECT_GT(top, 1.0f / (2.0f * float(kPi)));
+        EXPECT_GT(top, 1.0f / (2.0f * float(PiDouble)));
         EXPECT_GT(top, 4.f * grazing);
     }
 }
@@ -426,7 +426,7 @@ TEST(HemiField, UntrainedSamplingMatchesPdf) {
         chi2::SphereResult r = sphereTest(*f, region, 100 + uint64_t(region));
         EXPECT_TRUE(r.passed) << "region " << region << ": " << r.message;
         // The untrained policy is uniform over the region's hemisphere.
-        EXPECT_NEAR(f->pdf(region, f->regionNormal(region)), 1.0 / (2.0 * kPi), 1e-6);
+        EXPECT_NEAR(f->pdf(region, f->regionNormal(region)), 1.0 / (2.0 * PiDouble), 1e-6);
         EXPECT_EQ(f->pdf(region, -f->regionNormal(region)), 0.f);
         EXPECT_NEAR(strataIntegral(*f, region), 1.0, 1e-5);
         chi2::Result exact = strataTest(*f, region, 400 + uint64_t(region), 200000);
@@ -599,11 +599,11 @@ TEST(HemiField, RunningMeanConvergesToTargets) {
         EXPECT_EQ(g->q(region, j), double(j + 1));
         // Policy: P_j = 0.9 * T_j / sum(T) + 0.1 / n, pdf = P_j * n / (2 pi).
         double pj = 0.9 * (j + 1) / total + 0.1 / n;
-        EXPECT_NEAR(g->pdf(region, strataCentre(*g, region, j)), pj * n / (2.0 * kPi), 1e-6);
+        EXPECT_NEAR(g->pdf(region, strataCentre(*g, region, j)), pj * n / (2.0 * PiDouble), 1e-6);
     }
     // Untouched regions keep init and the uniform policy.
     EXPECT_EQ(g->q(0, 0), 1e-3);
-    EXPECT_NEAR(g->pdf(0, glm::vec3(0, 0, 1)), 1.0 / (2.0 * kPi), 1e-6);
+    EXPECT_NEAR(g->pdf(0, glm::vec3(0, 0, 1)), 1.0 / (2.0 * PiDouble), 1e-6);
 }
 
 // The bin that pdf() and sample() report is the stratum record() and radiance() would find:
@@ -782,7 +782,7 @@ TEST(HemiField, AllZeroRowFallsBackToUniform) {
     f->endPass();
     for (int j = 0; j < 4; ++j) {
         EXPECT_EQ(f->q(0, j), 0.0);
-        EXPECT_NEAR(f->pdf(0, strataCentre(*f, 0, j)), 1.0 / (2.0 * kPi), 1e-6);
+        EXPECT_NEAR(f->pdf(0, strataCentre(*f, 0, j)), 1.0 / (2.0 * PiDouble), 1e-6);
     }
 }
 
@@ -793,8 +793,8 @@ TEST(HemiField, ScatteredAndIrradianceEstimates) {
         const glm::vec3 n = f->regionNormal(region);
         // Uniform Q = c: the midpoint rule in cos(theta) is exact, (2pi/n) sum c cos_j = pi c.
         auto cosine = [&](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); };
-        EXPECT_NEAR(f->scatteredEstimate(region, cosine), 2.0 * kPi, 1e-5);
-        EXPECT_NEAR(f->irradianceEstimate(region, n), 2.0 * kPi, 1e-5);
+        EXPECT_NEAR(f->scatteredEstimate(region, cosine), 2.0 * PiDouble, 1e-5);
+        EXPECT_NEAR(f->irradianceEstimate(region, n), 2.0 * PiDouble, 1e-5);
         // A normal opposite to the region's hemisphere sees nothing.
         EXPECT_EQ(f->irradianceEstimate(region, -n), 0.f);
         // Bad fcos values count as zero.
@@ -806,7 +806,7 @@ TEST(HemiField, ScatteredAndIrradianceEstimates) {
         // clamp of the strata below ns's horizon: the documented approximation), computed
         // here stratum by stratum.
         glm::vec3 ns = glm::normalize(n + glm::vec3(0.2f, 0.3f, 0.1f));
-        HemiFrame frame = HemiFrame::fromZ(n);
+        Frame frame = Frame::fromZ(n);
         double moment = 0.0;
         for (int j = 0; j < f->layout().count(); ++j)
             moment += f->q(region, j) * glm::dot(frame.toWorld(f->layout().centre(j)), ns);

@@ -23,7 +23,6 @@
 namespace rlpbrt {
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
 
 // One region everywhere, uniform over the upper hemisphere (z > 0), recording every target
 // and counting its lookups and samples. Its bins: 0 below 60 degrees from the normal, 1 above
@@ -42,14 +41,14 @@ public:
     }
     glm::vec3 sample(int, glm::vec2 u, float, float* pdf, int* bin) const override {
         ++samples;
-        const float z = u.x, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * u.y;
+        const float z = u.x, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * Pi * u.y;
         const glm::vec3 w(r * std::cos(phi), r * std::sin(phi), z);
         *pdf = this->pdf(0, w, bin);
         return w;
     }
     float pdf(int, const glm::vec3& w, int* bin) const override {
         if (bin) *bin = binOf(w);
-        return w.z > 0.f ? 1.f / (2.f * kPi) : 0.f;
+        return w.z > 0.f ? 1.f / (2.f * Pi) : 0.f;
     }
     float scatteredEstimate(int, const std::function<float(const glm::vec3&)>&) const override {
         return 0.f;
@@ -140,7 +139,7 @@ TEST(GuideTargets, PathTargetIsTheMisWeightedReturnOfTheDirection) {
         // back with its record (the field need not find it again).
         EXPECT_EQ(r.bin, RecordingField::binOf(r.w)) << r.w.z;
         // The direction's mixture pdf: half the guide's uniform hemisphere, half Lambertian.
-        const float dirPdf = 0.5f / (2.f * kPi) + 0.5f * r.w.z / kPi;
+        const float dirPdf = 0.5f / (2.f * Pi) + 0.5f * r.w.z / Pi;
         const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
         const float lightPdf = sky.pdfLi(ctx, r.w, Vec3(0.f), Vec3(0.f));
         const float expected = lumSky * powerHeuristic(1, dirPdf, 1, lightPdf);
