@@ -317,9 +317,11 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
         m = std::make_unique<MatteMaterial>(std::make_shared<ConstantSpectrumTexture>(Spectrum(0.5f)),
                                             std::make_shared<ConstantFloatTexture>(0.f), nullptr);
     } else {
-        diag.error(e.loc, "unknown material type \"" + t + "\"");
-        *ok = false;
-        return nullptr;
+        // pbrt-v3 warns and makes a matte material from the same parameters.
+        diag.substituted(e.loc, "unknown material type \"" + t +
+                                    "\"; rendered as \"matte\" (as pbrt-v3)");
+        m = std::make_unique<MatteMaterial>(tex.spectrumTex(p, "Kd", Spectrum(0.5f)),
+                                            tex.floatTex(p, "sigma", 0.f), bump);
     }
     if (e.name.empty()) p.reportUnused("material \"" + t + "\"");
     else {
