@@ -168,6 +168,7 @@ struct FeatureScene {
 };
 const FeatureScene kFeatureScenes[] = {
     {"pbrt-features__disney", {70, 1.0}},
+    {"pbrt-features__nurbs", {}},
 };
 
 void PrintTo(const FeatureScene& f, std::ostream* os) { *os << f.id; }
