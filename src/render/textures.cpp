@@ -562,8 +562,15 @@ TexPtr<T> createCommon(const std::string& type, const ParamList& ps, const Mat4&
                                                  makeMapping3D(worldFromTexture), 0, 0.f);
     }
     if (type == "ptex") {
-        if (error) *error = "texture type \"ptex\" is not supported";
-        return nullptr;
+        // No Ptex library in Debian 12: a constant grey stands in (an error with --strict).
+        ps.markAllUsed();
+        if (Diagnostics* d = ps.diagnostics()) {
+            const Param* f = ps.find("filename");
+            d->ignored(f ? f->loc : FileLoc{},
+                       "texture type \"ptex\" is not supported (no Ptex library); a constant "
+                       "0.5 is used instead");
+        }
+        return std::make_shared<typename ConstantOf<T>::Type>(T(0.5f));
     }
     *known = false;
     return nullptr;
