@@ -254,6 +254,24 @@ struct DisneyClearcoat {
     BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
 };
 
+struct FourierTable;
+
+// pbrt-v3's FourierBSDF: a tabulated BSDF (fourier_bsdf.h) that outlives the lobe. f from the
+// table's Catmull-Rom interpolation in mu_i, mu_o and its Fourier series in phi (radiance
+// transmission scaled by 1/eta^2 as pbrt-v3); samples mu_i from the interpolated a0 spline and
+// phi from the luminance series, pdf = Y / (2 pi integral of a0).
+struct FourierBSDF {
+    const FourierTable* table;
+    TransportMode mode;
+    FourierBSDF(const FourierTable* table, TransportMode mode) : table(table), mode(mode) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const {
+        return BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Glossy;
+    }
+};
+
 // Any one lobe, stored by value.
 class BxDF {
   public:
@@ -261,7 +279,7 @@ class BxDF {
         std::variant<LambertianReflection, LambertianTransmission, OrenNayar,
                      SpecularReflection, SpecularTransmission, FresnelSpecular,
                      MicrofacetReflection, MicrofacetTransmission, FresnelBlend,
-                     DisneyDiffuseLobe, DisneyClearcoat>;
+                     DisneyDiffuseLobe, DisneyClearcoat, FourierBSDF>;
 
     // A black Lambertian reflection lobe.
     BxDF() = default;

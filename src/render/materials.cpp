@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "render/fourier_bsdf.h"
+
 namespace rlpbrt {
 
 Material::~Material() = default;
@@ -240,6 +242,22 @@ private:
     Textures t_;
 };
 
+// pbrt-v3's FourierMaterial: one tabulated lobe (none, a black surface, if the table could not
+// be read).
+class FourierMaterial : public SurfaceMaterial {
+public:
+    FourierMaterial(std::shared_ptr<const FourierTable> table, FTex bump)
+        : SurfaceMaterial(std::move(bump)), table_(std::move(table)) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        initFrame(si, textureContext(si), bsdf);
+        bsdf->clear();
+        if (table_) bsdf->add(FourierBSDF(table_.get(), TransportMode::Radiance));
+    }
+
+private:
+    std::shared_ptr<const FourierTable> table_;
+};
+
 // pbrt-v3's mix weights m1 by `amount` and m2 by 1 - amount; here one of them is chosen per
 // shading point with those probabilities (the same expectation). A coloured amount uses its
 // average as the probability.
@@ -369,7 +387,20 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
                          "scattering) is not supported yet; its diffuse lobe is used instead");
         }
         m = std::make_unique<DisneyMaterial>(std::move(dt), bump);
-    } else if (t == "fourier" || t == "hair" || t == "subsurface" || t == "kdsubsurface") {
+    } else if (t == "fourier") {
+        auto table = std::make_shared<FourierTable>();
+        std::string file = p.getFilename("bsdffile"), err;
+        if (!readFourierTable(file, table.get(), &err)) {
+            const Param* f = p.find("bsdffile");
+            diag.substituted(f ? f->loc : e.loc,
+                             (file.empty() ? std::string("fourier material without "
+                                                         "\"bsdffile\"")
+                                           : err) +
+                                 "; the surface is black (as pbrt-v3)");
+            table.reset();
+        }
+        m = std::make_unique<FourierMaterial>(std::move(table), bump);
+    } else if (t == "hair" || t == "subsurface" || t == "kdsubsurface") {
         p.markAllUsed();
         diag.ignored(e.loc, "material \"" + t + "\" is not supported; rendered as matte "
                             "(Kd 0.5) instead");

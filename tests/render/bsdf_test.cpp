@@ -422,7 +422,9 @@ TEST(BxDFEnergy, DisneyWhiteFurnace) {
                 SCOPED_TRACE(std::string(metal ? "metal " : "dielectric ") + w.name + " rough " +
                              std::to_string(rough));
                 EXPECT_LE(mean, 1.0 + 5.0 * se + 1e-4);
-                if (rough < 0.2f && std::abs(w.wo.z) > 0.4f) EXPECT_GE(mean, 0.97);
+                if (rough < 0.2f && std::abs(w.wo.z) > 0.4f) {
+                    EXPECT_GE(mean, 0.97);
+                }
             }
         }
     }
