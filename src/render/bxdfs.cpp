@@ -89,6 +89,19 @@ Spectrum Fresnel::evaluate(float cosThetaI) const {
 
 Spectrum LambertianReflection::f(const Vec3&, const Vec3&) const { return r * InvPi; }
 
+// The sample of a lobe at a chosen wi: its pdf and value (no sample if the pdf is 0 or not
+// finite).
+template <typename Lobe>
+BxDFSample sampleAt(const Lobe& lobe, const Vec3& wo, const Vec3& wi) {
+    BxDFSample s;
+    s.pdf = lobe.pdf(wo, wi);
+    if (!(s.pdf > 0.f) || !std::isfinite(s.pdf)) return BxDFSample();
+    s.wi = wi;
+    s.f = lobe.f(wo, wi);
+    s.flags = lobe.flags();
+    return s;
+}
+
 // Cosine-weighted sampling on wo's side, shared by the diffuse reflection lobes.
 template <typename Lobe>
 BxDFSample sampleCosineReflection(const Lobe& lobe, const Vec3& wo, Vec2 u) {
@@ -236,13 +249,7 @@ BxDFSample DisneyClearcoat::sampleF(const Vec3& wo, float, Vec2 u) const {
     if (!sameHemisphere(wo, wh)) wh = -wh;
     Vec3 wi = reflect(wo, wh);
     if (!sameHemisphere(wo, wi)) return BxDFSample();
-    BxDFSample s;
-    s.pdf = pdf(wo, wi);
-    if (!(s.pdf > 0.f) || !std::isfinite(s.pdf)) return BxDFSample();
-    s.wi = wi;
-    s.f = f(wo, wi);
-    s.flags = flags();
-    return s;
+    return sampleAt(*this, wo, wi);
 }
 
 float DisneyClearcoat::pdf(const Vec3& wo, const Vec3& wi) const {
@@ -448,13 +455,7 @@ BxDFSample FresnelBlend::sampleF(const Vec3& wo, float uc, Vec2 u) const {
         wi = reflect(wo, wh);
         if (!sameHemisphere(wo, wi)) return BxDFSample();
     }
-    BxDFSample s;
-    s.pdf = pdf(wo, wi);
-    if (!(s.pdf > 0.f) || !std::isfinite(s.pdf)) return BxDFSample();
-    s.wi = wi;
-    s.f = f(wo, wi);
-    s.flags = flags();
-    return s;
+    return sampleAt(*this, wo, wi);
 }
 
 float FresnelBlend::pdf(const Vec3& wo, const Vec3& wi) const {

@@ -286,24 +286,26 @@ float cosDPhi(const Vec3& a, const Vec3& b) {
     return clamp((a.x * b.x + a.y * b.y) / std::sqrt(axy * bxy), -1.f, 1.f);
 }
 
-// Interpolated Fourier coefficients at (muI, muO): nChannels blocks of t.mMax in ak; returns
-// the largest order (0 if out of the table).
-int interpolateCoefficients(const FourierTable& t, float muI, float muO, float* ak) {
-    int offI, offO;
-    float wI[4], wO[4];
+// Interpolated Fourier coefficients at (muI, muO) of the first `channels` channels: blocks of
+// t.mMax in ak; returns the largest order (0 if out of the table). *offO and wO: the mu_o
+// spline's nodes and weights.
+int interpolateCoefficients(const FourierTable& t, float muI, float muO, int channels,
+                            float* ak, int* offO, float wO[4]) {
+    int offI;
+    float wI[4];
     if (!catmullRomWeights(t.nMu, t.mu.data(), muI, &offI, wI) ||
-        !catmullRomWeights(t.nMu, t.mu.data(), muO, &offO, wO))
+        !catmullRomWeights(t.nMu, t.mu.data(), muO, offO, wO))
         return 0;
-    std::fill(ak, ak + size_t(t.mMax) * t.nChannels, 0.f);
+    std::fill(ak, ak + size_t(t.mMax) * channels, 0.f);
     int mMax = 0;
     for (int b = 0; b < 4; ++b)
         for (int a = 0; a < 4; ++a) {
             float w = wI[a] * wO[b];
             if (w == 0.f) continue;
             int m;
-            const float* ap = t.coefficients(offI + a, offO + b, &m);
+            const float* ap = t.coefficients(offI + a, *offO + b, &m);
             mMax = std::max(mMax, m);
-            for (int c = 0; c < t.nChannels; ++c)
+            for (int c = 0; c < channels; ++c)
                 for (int k = 0; k < m; ++k) ak[c * t.mMax + k] += w * ap[c * m + k];
         }
     return mMax;
@@ -330,8 +332,9 @@ Spectrum fourierValue(const FourierTable& t, TransportMode mode, const float* ak
 Spectrum FourierBSDF::f(const Vec3& wo, const Vec3& wi) const {
     const FourierTable& t = *table;
     float muI = -wi.z, muO = wo.z, cosPhi = cosDPhi(-wi, wo);
-    float ak[3 * kMaxOrder];
-    int mMax = interpolateCoefficients(t, muI, muO, ak);
+    float ak[3 * kMaxOrder], wO[4];
+    int offO;
+    int mMax = interpolateCoefficients(t, muI, muO, t.nChannels, ak, &offO, wO);
     if (mMax == 0) return Spectrum(0.f);
     float Y = std::max(0.f, fourierSeries(ak, mMax, cosPhi));
     return fourierValue(t, mode, ak, mMax, Y, muI, muO, cosPhi);
@@ -342,8 +345,9 @@ BxDFSample FourierBSDF::sampleF(const Vec3& wo, float, Vec2 u) const {
     float muO = wo.z, pdfMu;
     float muI = sampleCatmullRom2D(t.nMu, t.nMu, t.mu.data(), t.mu.data(), t.a0.data(),
                                    t.cdf.data(), muO, u.y, &pdfMu);
-    float ak[3 * kMaxOrder];
-    int mMax = interpolateCoefficients(t, muI, muO, ak);
+    float ak[3 * kMaxOrder], wO[4];
+    int offO;
+    int mMax = interpolateCoefficients(t, muI, muO, t.nChannels, ak, &offO, wO);
     if (mMax == 0 || !(ak[0] > 0.f)) return BxDFSample();
     float phi, pdfPhi;
     float Y = sampleFourier(ak, mMax, u.x, &pdfPhi, &phi);
@@ -371,22 +375,10 @@ BxDFSample FourierBSDF::sampleF(const Vec3& wo, float, Vec2 u) const {
 float FourierBSDF::pdf(const Vec3& wo, const Vec3& wi) const {
     const FourierTable& t = *table;
     float muI = -wi.z, muO = wo.z, cosPhi = cosDPhi(-wi, wo);
-    int offI, offO;
-    float wI[4], wO[4];
-    if (!catmullRomWeights(t.nMu, t.mu.data(), muI, &offI, wI) ||
-        !catmullRomWeights(t.nMu, t.mu.data(), muO, &offO, wO))
-        return 0.f;
-    float ak[kMaxOrder] = {};
-    int mMax = 0;
-    for (int o = 0; o < 4; ++o)
-        for (int i = 0; i < 4; ++i) {
-            float w = wI[i] * wO[o];
-            if (w == 0.f) continue;
-            int m;
-            const float* c = t.coefficients(offI + i, offO + o, &m);
-            mMax = std::max(mMax, m);
-            for (int k = 0; k < m; ++k) ak[k] += w * c[k];
-        }
+    float ak[kMaxOrder], wO[4];
+    int offO;
+    int mMax = interpolateCoefficients(t, muI, muO, 1, ak, &offO, wO);  // luminance only
+    if (mMax == 0) return 0.f;
     // rho: the integral of the luminance over the sphere at muO (2 pi x the a0 spline's
     // integral, interpolated in muO as sampleCatmullRom2D does).
     float rho = 0.f;

@@ -86,13 +86,16 @@ const Diagnostic* find(const Diagnostics& diag, Severity severity, const std::st
     return nullptr;
 }
 
+std::string scenePath(const ToleranceCase& c) {
+    return fs::weakly_canonical(test::sharedDir() + "/scenes/pbrt-features/tolerance/" + c.file);
+}
+
 class Tolerance : public ::testing::TestWithParam<ToleranceCase> {};
 
 TEST_P(Tolerance, RendersWithALocatedWarningAndPbrtV3sSubstitute) {
     RLPBRT_REQUIRE_SHARED();
     const ToleranceCase& c = GetParam();
-    const std::string path =
-        fs::weakly_canonical(test::sharedDir() + "/scenes/pbrt-features/tolerance/" + c.file);
+    const std::string path = scenePath(c);
     Diagnostics diag;
     diag.setStream(nullptr);
     Rendered tolerant = renderScene(path, diag);
@@ -125,8 +128,7 @@ TEST_P(Tolerance, RendersWithALocatedWarningAndPbrtV3sSubstitute) {
 TEST_P(Tolerance, StrictModeMakesTheSubstituteALocatedError) {
     RLPBRT_REQUIRE_SHARED();
     const ToleranceCase& c = GetParam();
-    const std::string path =
-        fs::weakly_canonical(test::sharedDir() + "/scenes/pbrt-features/tolerance/" + c.file);
+    const std::string path = scenePath(c);
     Diagnostics diag;
     diag.setStream(nullptr);
     diag.setStrict(true);
@@ -139,8 +141,7 @@ TEST_P(Tolerance, StrictModeMakesTheSubstituteALocatedError) {
 TEST_P(Tolerance, StrictCliFailsWithoutOutput) {
     RLPBRT_REQUIRE_SHARED();
     const ToleranceCase& c = GetParam();
-    const std::string path =
-        fs::weakly_canonical(test::sharedDir() + "/scenes/pbrt-features/tolerance/" + c.file);
+    const std::string path = scenePath(c);
     const std::string out = fs::temp_directory_path().string() + "/rlpbrt-strict-" +
                             std::to_string(getpid()) + ".exr";
     const std::string cmd = "timeout -k 5 60 '" + std::string(RLPBRT_BINARY) + "' --strict --quiet '" +
