@@ -50,6 +50,10 @@ void Diagnostics::fatal(const FileLoc& loc, const std::string& message) {
 }
 
 void Diagnostics::ignored(const FileLoc& loc, const std::string& feature) {
+    if (strict_) {
+        error(loc, feature + " [--strict]");
+        return;
+    }
     auto it = ignoredIndex_.find(feature);
     if (it == ignoredIndex_.end()) {
         ignoredIndex_[feature] = ignored_.size();

@@ -53,8 +53,17 @@ public:
     [[noreturn]] void fatal(const FileLoc& loc, const std::string& message);
 
     // Record a scene feature that is parsed but ignored (printed as a warning once per
-    // distinct message; the summary lists them all with their counts).
+    // distinct message; the summary lists them all with their counts). An error in strict
+    // mode.
     void ignored(const FileLoc& loc, const std::string& feature);
+    // Record input that pbrt-v3 tolerates with a substitute (an undefined named material, an
+    // unknown material type, an unreadable image): a warning naming the substitute, or an
+    // error in strict mode. Listed with the ignored features.
+    void substituted(const FileLoc& loc, const std::string& what) { ignored(loc, what); }
+
+    // Strict mode (--strict): ignored features and substitutions are errors.
+    void setStrict(bool strict) { strict_ = strict; }
+    bool strict() const { return strict_; }
 
     int errorCount() const { return errors_; }
     int warningCount() const { return warnings_; }
@@ -72,6 +81,7 @@ private:
     void emit(Severity s, const FileLoc& loc, const std::string& message);
 
     std::ostream* stream_;
+    bool strict_ = false;
     int errors_ = 0, warnings_ = 0;
     std::vector<Diagnostic> all_;
     std::unordered_map<std::string, int> repeats_;

@@ -142,4 +142,22 @@ void buildTranslucent(BSDF& bsdf, Spectrum kd, Spectrum ks, Spectrum reflect,
                       Spectrum transmit, float roughness, bool remap,
                       TransportMode mode = TransportMode::Radiance);
 
+// disney (pbrt-v3's DisneyMaterial, Burley 2012/2015), from evaluated parameters; names and
+// defaults are pbrt-v3's. With diffuse weight dw = (1 - metallic)(1 - spectrans) > 0:
+// DisneyDiffuse(dw c) (thin: DisneyDiffuse(dw (1 - flatness)(1 - difftrans / 2) c) +
+// FakeSS(dw flatness (1 - difftrans / 2) c)) + Retro(dw c) + Sheen(dw sheen lerp(sheentint, 1,
+// tint)) if sheen > 0; then MicrofacetReflection(1, TR, DisneyFresnel) +
+// DisneyClearcoat if clearcoat > 0 + MicrofacetTransmission(spectrans sqrt(c)) if spectrans > 0
+// (thin: with roughness scaled by 0.65 eta - 0.35) + thin: LambertianTransmission(difftrans / 2
+// c). A non-black scatterdistance (pbrt-v3's BSSRDF, not thin) is rendered with DisneyDiffuse
+// (the caller warns). BSDF eta 1, as pbrt-v3's.
+struct DisneyParams {
+    Spectrum color{0.5f};
+    float metallic = 0.f, eta = 1.5f, roughness = 0.5f, specularTint = 0.f, anisotropic = 0.f;
+    float sheen = 0.f, sheenTint = 0.5f, clearcoat = 0.f, clearcoatGloss = 1.f;
+    float specTrans = 0.f, flatness = 0.f, diffTrans = 1.f;
+    bool thin = false;
+};
+void buildDisney(BSDF& bsdf, const DisneyParams& p, TransportMode mode = TransportMode::Radiance);
+
 }  // namespace rlpbrt

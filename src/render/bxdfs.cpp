@@ -61,8 +61,23 @@ Fresnel Fresnel::conductor(const Spectrum& etaI, const Spectrum& etaT, const Spe
     return f;
 }
 
+Fresnel Fresnel::disney(const Spectrum& r0, float metallic, float eta) {
+    Fresnel f;
+    f.kind_ = Kind::Disney;
+    f.k_ = r0;                   // R0 of the Schlick part
+    f.etaI_ = Spectrum(metallic);  // the blend weight
+    f.etaT_ = Spectrum(eta);     // the dielectric's index (from 1)
+    return f;
+}
+
 Spectrum Fresnel::evaluate(float cosThetaI) const {
     switch (kind_) {
+    case Kind::Disney: {
+        float metallic = etaI_.x;
+        Spectrum schlick = k_ + (Spectrum(1.f) - k_) * schlickWeight(cosThetaI);
+        return (1.f - metallic) * Spectrum(frDielectric(cosThetaI, 1.f, etaT_.x)) +
+               metallic * schlick;
+    }
     case Kind::Dielectric: return Spectrum(frDielectric(cosThetaI, etaI_.x, etaT_.x));
     case Kind::Conductor: return frConductor(std::abs(cosThetaI), etaI_, etaT_, k_);
     case Kind::NoOp: break;
@@ -73,6 +88,19 @@ Spectrum Fresnel::evaluate(float cosThetaI) const {
 // ---- Lambertian --------------------------------------------------------------------------
 
 Spectrum LambertianReflection::f(const Vec3&, const Vec3&) const { return r * InvPi; }
+
+// The sample of a lobe at a chosen wi: its pdf and value (no sample if the pdf is 0 or not
+// finite).
+template <typename Lobe>
+BxDFSample sampleAt(const Lobe& lobe, const Vec3& wo, const Vec3& wi) {
+    BxDFSample s;
+    s.pdf = lobe.pdf(wo, wi);
+    if (!(s.pdf > 0.f) || !std::isfinite(s.pdf)) return BxDFSample();
+    s.wi = wi;
+    s.f = lobe.f(wo, wi);
+    s.flags = lobe.flags();
+    return s;
+}
 
 // Cosine-weighted sampling on wo's side, shared by the diffuse reflection lobes.
 template <typename Lobe>
@@ -150,6 +178,88 @@ BxDFSample OrenNayar::sampleF(const Vec3& wo, float, Vec2 u) const {
 
 float OrenNayar::pdf(const Vec3& wo, const Vec3& wi) const {
     return sameHemisphere(wo, wi) ? absCosTheta(wi) * InvPi : 0.f;
+}
+
+// ---- Disney lobes --------------------------------------------------------------------------
+
+Spectrum DisneyDiffuseLobe::f(const Vec3& wo, const Vec3& wi) const {
+    float fo = schlickWeight(absCosTheta(wo)), fi = schlickWeight(absCosTheta(wi));
+    if (kind == Kind::Diffuse) return r * InvPi * (1.f - 0.5f * fo) * (1.f - 0.5f * fi);
+    Vec3 wh = wi + wo;
+    if (wh.x == 0.f && wh.y == 0.f && wh.z == 0.f) return Spectrum(0.f);
+    float cosD = glm::dot(wi, glm::normalize(wh));
+    switch (kind) {
+    case Kind::FakeSS: {
+        float f90 = cosD * cosD * roughness;
+        float fss = (fo + (1.f - fo) * f90) * (fi + (1.f - fi) * f90);
+        float ss = 1.25f * (fss * (1.f / (absCosTheta(wo) + absCosTheta(wi)) - 0.5f) + 0.5f);
+        return r * InvPi * ss;
+    }
+    case Kind::Retro: {
+        float rr = 2.f * roughness * cosD * cosD;
+        return r * InvPi * rr * (fo + fi + fo * fi * (rr - 1.f));
+    }
+    case Kind::Sheen: return r * schlickWeight(cosD);
+    case Kind::Diffuse: break;
+    }
+    return Spectrum(0.f);
+}
+
+BxDFSample DisneyDiffuseLobe::sampleF(const Vec3& wo, float, Vec2 u) const {
+    return sampleCosineReflection(*this, wo, u);
+}
+
+float DisneyDiffuseLobe::pdf(const Vec3& wo, const Vec3& wi) const {
+    return sameHemisphere(wo, wi) ? absCosTheta(wi) * InvPi : 0.f;
+}
+
+namespace {
+// Burley's GTR1 ("generalized Trowbridge-Reitz", gamma 1) of the normal's cosine, normalised
+// so that D cos integrates to 1 over the hemisphere.
+float gtr1(float cosTheta, float alpha) {
+    float a2 = alpha * alpha;
+    return (a2 - 1.f) / (Pi * std::log(a2) * (1.f + (a2 - 1.f) * cosTheta * cosTheta));
+}
+// Smith GGX masking divided by 2 |cos| (Burley's smithG_GGX form).
+float smithGgxOverCos(float cosTheta, float alpha) {
+    float a2 = alpha * alpha, c2 = cosTheta * cosTheta;
+    return 1.f / (cosTheta + std::sqrt(a2 + c2 - a2 * c2));
+}
+}  // namespace
+
+Spectrum DisneyClearcoat::f(const Vec3& wo, const Vec3& wi) const {
+    Vec3 wh = wi + wo;
+    if (wh.x == 0.f && wh.y == 0.f && wh.z == 0.f) return Spectrum(0.f);
+    wh = glm::normalize(wh);
+    float d = gtr1(absCosTheta(wh), alpha());
+    float fr = 0.04f + 0.96f * schlickWeight(glm::dot(wo, wh));
+    float g = smithGgxOverCos(absCosTheta(wo), 0.25f) * smithGgxOverCos(absCosTheta(wi), 0.25f);
+    return Spectrum(0.25f * weight * g * fr * d);
+}
+
+BxDFSample DisneyClearcoat::sampleF(const Vec3& wo, float, Vec2 u) const {
+    if (wo.z == 0.f) return BxDFSample();
+    float a2 = alpha() * alpha();
+    // Inverse of the CDF of cos(wh) under D cos: ln(1 + (a2 - 1) c^2) / ln(a2).
+    float cos2 = (1.f - std::pow(a2, 1.f - u.x)) / (1.f - a2);
+    float cosTheta = std::sqrt(clamp(cos2, 0.f, 1.f));
+    float sinTheta = safeSqrt(1.f - cosTheta * cosTheta);
+    float phi = 2.f * Pi * u.y;
+    Vec3 wh(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta);
+    if (!sameHemisphere(wo, wh)) wh = -wh;
+    Vec3 wi = reflect(wo, wh);
+    if (!sameHemisphere(wo, wi)) return BxDFSample();
+    return sampleAt(*this, wo, wi);
+}
+
+float DisneyClearcoat::pdf(const Vec3& wo, const Vec3& wi) const {
+    if (!sameHemisphere(wo, wi)) return 0.f;
+    Vec3 wh = wi + wo;
+    if (wh.x == 0.f && wh.y == 0.f && wh.z == 0.f) return 0.f;
+    wh = glm::normalize(wh);
+    float woDotWh = std::abs(glm::dot(wo, wh));
+    if (woDotWh == 0.f) return 0.f;
+    return gtr1(absCosTheta(wh), alpha()) * absCosTheta(wh) / (4.f * woDotWh);
 }
 
 // ---- Specular lobes ----------------------------------------------------------------------
@@ -345,13 +455,7 @@ BxDFSample FresnelBlend::sampleF(const Vec3& wo, float uc, Vec2 u) const {
         wi = reflect(wo, wh);
         if (!sameHemisphere(wo, wi)) return BxDFSample();
     }
-    BxDFSample s;
-    s.pdf = pdf(wo, wi);
-    if (!(s.pdf > 0.f) || !std::isfinite(s.pdf)) return BxDFSample();
-    s.wi = wi;
-    s.f = f(wo, wi);
-    s.flags = flags();
-    return s;
+    return sampleAt(*this, wo, wi);
 }
 
 float FresnelBlend::pdf(const Vec3& wo, const Vec3& wi) const {

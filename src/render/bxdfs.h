@@ -50,10 +50,17 @@ float frDielectric(float cosThetaI, float etaI, float etaT);
 Spectrum frConductor(float cosThetaI, const Spectrum& etaI, const Spectrum& etaT,
                      const Spectrum& k);
 
-// A Fresnel term stored by value: no-op (always 1), dielectric, or conductor.
+// Schlick's weight (1 - cos)^5, cos clamped to [0, 1].
+inline float schlickWeight(float cosTheta) {
+    float m = clamp(1.f - cosTheta, 0.f, 1.f);
+    return (m * m) * (m * m) * m;
+}
+
+// A Fresnel term stored by value: no-op (always 1), dielectric, conductor, or the Disney
+// BSDF's blend of a dielectric and Schlick's approximation.
 class Fresnel {
   public:
-    enum class Kind : uint8_t { NoOp, Dielectric, Conductor };
+    enum class Kind : uint8_t { NoOp, Dielectric, Conductor, Disney };
     Fresnel() = default;
     // Always returns 1 (pbrt FresnelNoOp, used by the mirror material).
     static Fresnel noOp() { return Fresnel(); }
@@ -61,6 +68,9 @@ class Fresnel {
     static Fresnel dielectric(float etaI, float etaT);
     // Conductor; pbrt-v3's evaluate uses |cosThetaI|.
     static Fresnel conductor(const Spectrum& etaI, const Spectrum& etaT, const Spectrum& k);
+    // pbrt-v3's DisneyFresnel: (1 - metallic) FrDielectric(cos, 1, eta) + metallic
+    // Schlick(r0, cos).
+    static Fresnel disney(const Spectrum& r0, float metallic, float eta);
 
     Kind kind() const { return kind_; }
     // Reflectance for the cosine of the incident direction with the normal.
@@ -206,13 +216,70 @@ struct FresnelBlend {
     BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
 };
 
+// The Disney BSDF's diffuse-like reflection lobes (pbrt-v3's DisneyDiffuse, DisneyFakeSS,
+// DisneyRetro, DisneySheen; Burley 2012 and 2015), with Fo, Fi = schlickWeight(|cos|) of wo, wi
+// and cos d = wi . normalize(wo + wi):
+//   Diffuse: R / pi (1 - Fo / 2) (1 - Fi / 2)
+//   FakeSS:  R / pi 1.25 (Fss (1 / (|cos o| + |cos i|) - 0.5) + 0.5), Fss = lerp(Fo, 1, F90)
+//            lerp(Fi, 1, F90), F90 = cos^2 d roughness (Hanrahan-Krueger-like flattening)
+//   Retro:   R / pi Rr (Fo + Fi + Fo Fi (Rr - 1)), Rr = 2 roughness cos^2 d
+//   Sheen:   R schlickWeight(cos d)
+// All reflection | diffuse, sampled cosine-weighted on wo's side (pbrt-v3's default BxDF
+// sampling).
+struct DisneyDiffuseLobe {
+    enum class Kind : uint8_t { Diffuse, FakeSS, Retro, Sheen };
+    Spectrum r;
+    float roughness;
+    Kind kind;
+    DisneyDiffuseLobe(Kind kind, const Spectrum& r, float roughness = 0.f)
+        : r(r), roughness(roughness), kind(kind) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Diffuse; }
+};
+
+// The Disney clearcoat (pbrt-v3's DisneyClearcoat): 0.25 weight D G F with the GTR1
+// distribution of alpha lerp(gloss, 0.1, 0.001), Schlick's Fresnel with R0 = 0.04 and the
+// separable Smith GGX masking of alpha 0.25. Sampled exactly from GTR1's D(wh) cos(wh), so
+// the pdf is D cos(wh) / (4 wo.wh) (pbrt-v3 samples alpha 0.25 but reports the pdf of the gloss
+// alpha without the cosine: a density mismatch this implementation does not copy).
+struct DisneyClearcoat {
+    float weight, gloss;
+    DisneyClearcoat(float weight, float gloss) : weight(weight), gloss(gloss) {}
+    float alpha() const { return 0.1f + gloss * (0.001f - 0.1f); }
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
+};
+
+struct FourierTable;
+
+// pbrt-v3's FourierBSDF: a tabulated BSDF (fourier_bsdf.h) that outlives the lobe. f from the
+// table's Catmull-Rom interpolation in mu_i, mu_o and its Fourier series in phi (radiance
+// transmission scaled by 1/eta^2 as pbrt-v3); samples mu_i from the interpolated a0 spline and
+// phi from the luminance series, pdf = Y / (2 pi integral of a0).
+struct FourierBSDF {
+    const FourierTable* table;
+    TransportMode mode;
+    FourierBSDF(const FourierTable* table, TransportMode mode) : table(table), mode(mode) {}
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const {
+        return BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Glossy;
+    }
+};
+
 // Any one lobe, stored by value.
 class BxDF {
   public:
     using Variant =
         std::variant<LambertianReflection, LambertianTransmission, OrenNayar,
                      SpecularReflection, SpecularTransmission, FresnelSpecular,
-                     MicrofacetReflection, MicrofacetTransmission, FresnelBlend>;
+                     MicrofacetReflection, MicrofacetTransmission, FresnelBlend,
+                     DisneyDiffuseLobe, DisneyClearcoat, FourierBSDF>;
 
     // A black Lambertian reflection lobe.
     BxDF() = default;

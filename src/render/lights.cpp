@@ -73,8 +73,8 @@ std::shared_ptr<MipMap<Spectrum>> readLightMap(const std::string& path, const Sp
     Image img;
     std::string error;
     if (!readImage(path, &img, &error)) {
-        diag.warning(loc, "cannot read light map \"" + path + "\": " + error +
-                              "; using a constant map");
+        diag.substituted(loc, "cannot read light map \"" + path + "\": " + error +
+                                  "; using a constant map (as pbrt-v3)");
         return nullptr;
     }
     std::vector<Spectrum> texels(size_t(img.width) * img.height);

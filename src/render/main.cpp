@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
     std::string scenePath, outFile, statsFile, guide = "hemi", curveFile, refFile;
     std::string guideSave, guideLoad;
-    bool parseOnly = false, quiet = false;
+    bool parseOnly = false, quiet = false, strict = false;
     int spp = 0, nThreads = 0;
     double timeBudget = 0.0, checkpointEvery = -1.0;
     uint64_t seed = 0;
@@ -81,6 +81,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 4096));
     app.add_option("--seed", seed, "random seed");
     app.add_flag("--quiet,-q", quiet, "no progress or summary output");
+    app.add_flag("--strict", strict, "treat every unsupported feature and every substitute "
+                                     "(pbrt-v3's tolerance of bad input) as an error");
     std::vector<std::string> guideParams;
     app.add_option("--guide", guide, "guiding backend: none, hemi (the default) or vdb")
         ->check(CLI::IsMember({"none", "hemi", "vdb"}));
@@ -111,6 +113,7 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, onSignal);
 
     Diagnostics diag;
+    diag.setStrict(strict);
     double t0 = seconds();
     SceneDesc desc;
     bool ok = loadSceneDesc(scenePath, diag, &desc);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "render/fourier_bsdf.h"
+
 namespace rlpbrt {
 
 Material::~Material() = default;
@@ -205,6 +207,57 @@ private:
     bool remap_;
 };
 
+// pbrt-v3's DisneyMaterial (buildDisney has the lobes).
+class DisneyMaterial : public SurfaceMaterial {
+public:
+    struct Textures {
+        STex color, scatterDistance;
+        FTex metallic, eta, roughness, specularTint, anisotropic, sheen, sheenTint, clearcoat,
+            clearcoatGloss, specTrans, flatness, diffTrans;
+        bool thin = false;
+    };
+    DisneyMaterial(Textures t, FTex bump) : SurfaceMaterial(std::move(bump)), t_(std::move(t)) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf);
+        DisneyParams p;
+        p.color = t_.color->evaluate(tc);
+        p.metallic = t_.metallic->evaluate(tc);
+        p.eta = t_.eta->evaluate(tc);
+        p.roughness = t_.roughness->evaluate(tc);
+        p.specularTint = t_.specularTint->evaluate(tc);
+        p.anisotropic = t_.anisotropic->evaluate(tc);
+        p.sheen = t_.sheen->evaluate(tc);
+        p.sheenTint = t_.sheenTint->evaluate(tc);
+        p.clearcoat = t_.clearcoat->evaluate(tc);
+        p.clearcoatGloss = t_.clearcoatGloss->evaluate(tc);
+        p.specTrans = t_.specTrans->evaluate(tc);
+        p.thin = t_.thin;
+        if (p.thin) p.flatness = t_.flatness->evaluate(tc);
+        p.diffTrans = t_.diffTrans->evaluate(tc);
+        buildDisney(*bsdf, p);
+    }
+
+private:
+    Textures t_;
+};
+
+// pbrt-v3's FourierMaterial: one tabulated lobe (none, a black surface, if the table could not
+// be read).
+class FourierMaterial : public SurfaceMaterial {
+public:
+    FourierMaterial(std::shared_ptr<const FourierTable> table, FTex bump)
+        : SurfaceMaterial(std::move(bump)), table_(std::move(table)) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        initFrame(si, textureContext(si), bsdf);
+        bsdf->clear();
+        if (table_) bsdf->add(FourierBSDF(table_.get(), TransportMode::Radiance));
+    }
+
+private:
+    std::shared_ptr<const FourierTable> table_;
+};
+
 // pbrt-v3's mix weights m1 by `amount` and m2 by 1 - amount; here one of them is chosen per
 // shading point with those probabilities (the same expectation). A coloured amount uses its
 // average as the probability.
@@ -309,17 +362,56 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
             ms[i] = materials[size_t(names.rend() - it - 1)];
         }
         m = std::make_unique<MixMaterial>(ms[0], ms[1], tex.spectrumTex(p, "amount", Spectrum(0.5f)));
-    } else if (t == "fourier" || t == "hair" || t == "disney" || t == "subsurface" ||
-               t == "kdsubsurface") {
+    } else if (t == "disney") {
+        DisneyMaterial::Textures dt;
+        dt.color = tex.spectrumTex(p, "color", Spectrum(0.5f));
+        dt.metallic = tex.floatTex(p, "metallic", 0.f);
+        dt.eta = tex.floatTex(p, "eta", 1.5f);
+        dt.roughness = tex.floatTex(p, "roughness", 0.5f);
+        dt.specularTint = tex.floatTex(p, "speculartint", 0.f);
+        dt.anisotropic = tex.floatTex(p, "anisotropic", 0.f);
+        dt.sheen = tex.floatTex(p, "sheen", 0.f);
+        dt.sheenTint = tex.floatTex(p, "sheentint", 0.5f);
+        dt.clearcoat = tex.floatTex(p, "clearcoat", 0.f);
+        dt.clearcoatGloss = tex.floatTex(p, "clearcoatgloss", 1.f);
+        dt.specTrans = tex.floatTex(p, "spectrans", 0.f);
+        dt.scatterDistance = tex.spectrumTex(p, "scatterdistance", Spectrum(0.f));
+        dt.thin = p.getBool("thin", false);
+        dt.flatness = tex.floatTex(p, "flatness", 0.f);
+        dt.diffTrans = tex.floatTex(p, "difftrans", 1.f);
+        auto* sd = dynamic_cast<const ConstantSpectrumTexture*>(dt.scatterDistance.get());
+        if (!dt.thin && !(sd && isBlack(sd->value()))) {
+            const Param* sp = p.find("scatterdistance");
+            diag.ignored(sp ? sp->loc : e.loc,
+                         "disney material: \"scatterdistance\" (pbrt-v3's subsurface "
+                         "scattering) is not supported yet; its diffuse lobe is used instead");
+        }
+        m = std::make_unique<DisneyMaterial>(std::move(dt), bump);
+    } else if (t == "fourier") {
+        auto table = std::make_shared<FourierTable>();
+        std::string file = p.getFilename("bsdffile"), err;
+        if (!readFourierTable(file, table.get(), &err)) {
+            const Param* f = p.find("bsdffile");
+            diag.substituted(f ? f->loc : e.loc,
+                             (file.empty() ? std::string("fourier material without "
+                                                         "\"bsdffile\"")
+                                           : err) +
+                                 "; the surface is black (as pbrt-v3)");
+            table.reset();
+        }
+        m = std::make_unique<FourierMaterial>(std::move(table), bump);
+    } else if (t == "hair" || t == "subsurface" || t == "kdsubsurface") {
         p.markAllUsed();
         diag.ignored(e.loc, "material \"" + t + "\" is not supported; rendered as matte "
                             "(Kd 0.5) instead");
         m = std::make_unique<MatteMaterial>(std::make_shared<ConstantSpectrumTexture>(Spectrum(0.5f)),
                                             std::make_shared<ConstantFloatTexture>(0.f), nullptr);
     } else {
-        diag.error(e.loc, "unknown material type \"" + t + "\"");
-        *ok = false;
-        return nullptr;
+        // pbrt-v3 warns and makes a matte material from the same parameters.
+        diag.substituted(e.loc, "unknown material type \"" + t +
+                                    "\"; rendered as \"matte\" (as pbrt-v3)");
+        m = std::make_unique<MatteMaterial>(tex.spectrumTex(p, "Kd", Spectrum(0.5f)),
+                                            tex.floatTex(p, "sigma", 0.f), bump);
     }
     if (e.name.empty()) p.reportUnused("material \"" + t + "\"");
     else {

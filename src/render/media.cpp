@@ -180,7 +180,7 @@ std::unique_ptr<Medium> createMedium(const MediumEntity& e, Diagnostics& diag) {
     Spectrum sigA(.0011f, .0024f, .014f), sigS(2.55f, 3.21f, 3.77f);
     std::string preset = ps.getString("preset", "");
     if (!preset.empty())
-        diag.warning(ps.find("preset")->loc, "medium preset \"" + preset +
+        diag.substituted(ps.find("preset")->loc, "medium preset \"" + preset +
                                                  "\" is not available in rlpbrt; using the "
                                                  "default sigma_a and sigma_s");
     float scale = ps.getFloat("scale", 1.f);

@@ -481,7 +481,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         if (type != "image" && type != "rgb" && type != "gbuffer" && type != "spectral")
             diag.error(desc.film.loc, "unknown film type \"" + type + "\"");
         if (type != "image" && desc.film.present)
-            diag.warning(desc.film.loc, "film \"" + type + "\" is treated as \"image\"");
+            diag.substituted(desc.film.loc, "film \"" + type + "\" is treated as \"image\"");
         s.filmParams = parseFilm(desc.film.params, &err);
         if (!err.empty()) {
             diag.error(desc.film.loc, err);
@@ -529,7 +529,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         if (is.maxDepth < 0) diag.error(in.loc, "maxdepth must not be negative");
         if (is.lightSampleStrategy != "uniform" && is.lightSampleStrategy != "power" &&
             is.lightSampleStrategy != "spatial") {
-            diag.warning(in.loc, "unknown lightsamplestrategy \"" + is.lightSampleStrategy +
+            diag.substituted(in.loc, "unknown lightsamplestrategy \"" + is.lightSampleStrategy +
                                      "\"; using \"spatial\"");
             is.lightSampleStrategy = "spatial";
         }

@@ -317,7 +317,10 @@ void SceneBuilder::namedMaterial(const std::string& name, FileLoc loc) {
     if (!inWorld("NamedMaterial", loc)) return;
     auto it = gs_.namedMaterials->find(name);
     if (it == gs_.namedMaterials->end()) {
-        diag_.error(loc, "undefined named material \"" + name + "\"");
+        // pbrt-v3 reports it and keeps the current material (a scene may use a name before
+        // its MakeNamedMaterial).
+        diag_.substituted(loc, "undefined named material \"" + name +
+                                   "\"; the current material is kept (as pbrt-v3)");
         return;
     }
     gs_.material = it->second;

@@ -4,6 +4,7 @@
 
 #include "parser/ply.h"
 #include "render/loop_subdiv.h"
+#include "render/nurbs.h"
 #include "render/transform.h"
 
 namespace rlpbrt {
@@ -214,6 +215,51 @@ bool makeHeightField(const ShapeEntity& e, Diagnostics& diag, TriangleMesh* m) {
     return finishMesh(e, diag, m);
 }
 
+// pbrt-v3's "nurbs": nu, nv, uorder, vorder, uknots, vknots, u0, u1, v0, v1 (defaults: the
+// knot vectors' valid range), "point3 P" or homogeneous "float Pw"; tessellated (nurbs.h).
+bool makeNurbs(const ShapeEntity& e, Diagnostics& diag, TriangleMesh* m) {
+    const ParamList& ps = e.params;
+    NurbsPatch s;
+    s.nu = ps.getInt("nu", -1);
+    s.nv = ps.getInt("nv", -1);
+    s.uOrder = ps.getInt("uorder", -1);
+    s.vOrder = ps.getInt("vorder", -1);
+    s.uKnots = ps.getFloats("uknots");
+    s.vKnots = ps.getFloats("vknots");
+    for (const char* name : {"nu", "nv", "uorder", "vorder", "uknots", "vknots"})
+        if (!ps.has(name)) {
+            diag.error(e.loc, ctx(e) + ": needs \"" + name + "\"");
+            return false;
+        }
+    auto knot = [](const std::vector<float>& k, int i) {
+        return i >= 0 && size_t(i) < k.size() ? k[size_t(i)] : 0.f;
+    };
+    s.u0 = ps.getFloat("u0", knot(s.uKnots, s.uOrder - 1));
+    s.u1 = ps.getFloat("u1", knot(s.uKnots, s.nu));
+    s.v0 = ps.getFloat("v0", knot(s.vKnots, s.vOrder - 1));
+    s.v1 = ps.getFloat("v1", knot(s.vKnots, s.nv));
+    if (ps.has("P")) {
+        for (const Float3& a : ps.getPoint3s("P")) s.cp.emplace_back(a[0], a[1], a[2], 1.f);
+    } else if (ps.has("Pw")) {
+        std::vector<float> w = ps.getFloats("Pw");
+        if (w.size() % 4 != 0) {
+            diag.error(e.loc, ctx(e) + ": the number of \"Pw\" values must be a multiple of 4");
+            return false;
+        }
+        for (size_t i = 0; i < w.size(); i += 4) s.cp.emplace_back(w[i], w[i + 1], w[i + 2], w[i + 3]);
+    } else {
+        diag.error(e.loc, ctx(e) + ": needs control points \"point3 P\" or \"float Pw\"");
+        return false;
+    }
+    std::string err;
+    if (!validateNurbs(s, &err)) {
+        diag.error(e.loc, ctx(e) + ": " + err);
+        return false;
+    }
+    tessellateNurbs(s, &m->p, &m->n, &m->uv, &m->indices);
+    return finishMesh(e, diag, m);
+}
+
 bool makeQuadric(const ShapeEntity& e, Diagnostics& diag, QuadricShape* q) {
     const ParamList& p = e.params;
     Quadric& Q = q->quadric;
@@ -270,11 +316,12 @@ bool createShape(const ShapeEntity& e, Diagnostics& diag, ShapeData* out) {
     }
     bool ok;
     if (e.type == "trianglemesh" || e.type == "plymesh" || e.type == "loopsubdiv" ||
-        e.type == "heightfield") {
+        e.type == "heightfield" || e.type == "nurbs") {
         auto m = std::make_shared<TriangleMesh>();
         if (e.type == "trianglemesh") ok = makeTriangleMesh(e, diag, m.get());
         else if (e.type == "plymesh") ok = makePlyMesh(e, diag, m.get());
         else if (e.type == "loopsubdiv") ok = makeLoopSubdiv(e, diag, m.get());
+        else if (e.type == "nurbs") ok = makeNurbs(e, diag, m.get());
         else ok = makeHeightField(e, diag, m.get());
         if (ok) out->mesh = std::move(m);
     } else if (e.type == "sphere" || e.type == "disk" || e.type == "cylinder" ||
@@ -282,7 +329,7 @@ bool createShape(const ShapeEntity& e, Diagnostics& diag, ShapeData* out) {
         auto q = std::make_shared<QuadricShape>();
         ok = makeQuadric(e, diag, q.get());
         if (ok) out->quadric = std::move(q);
-    } else if (e.type == "curve" || e.type == "nurbs") {
+    } else if (e.type == "curve") {
         e.params.markAllUsed();
         diag.ignored(e.loc, "shape \"" + e.type + "\" is not supported; it is skipped");
         return false;

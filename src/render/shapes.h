@@ -1,5 +1,5 @@
 // Shapes as render data: triangle meshes and analytic quadrics, made from Shape entities
-// (trianglemesh, plymesh, loopsubdiv, heightfield, sphere, disk, cylinder, ...). No Embree
+// (trianglemesh, plymesh, loopsubdiv, heightfield, nurbs, sphere, disk, cylinder, ...). No Embree
 // here: scene.cpp turns these into Embree geometry.
 #pragma once
 

@@ -2,6 +2,7 @@
 #include "render/textures.h"
 
 #include <cctype>
+#include <sstream>
 #include <utility>
 
 #include "render/image_io.h"
@@ -97,6 +98,9 @@ template <typename T> struct TexBase;
 template <> struct TexBase<float> { using Type = FloatTexture; };
 template <> struct TexBase<Spectrum> { using Type = SpectrumTexture; };
 template <typename T> using TexPtr = std::shared_ptr<typename TexBase<T>::Type>;
+template <typename T> struct ConstantOf;
+template <> struct ConstantOf<float> { using Type = ConstantFloatTexture; };
+template <> struct ConstantOf<Spectrum> { using Type = ConstantSpectrumTexture; };
 
 TexPtr<float> resolve(TextureResolver& r, const ParamList& ps, const std::string& name,
                       float def) {
@@ -360,11 +364,18 @@ private:
 // ---------------------------------------------------------------------------------------------
 // Factory helpers.
 
+// A substitute for a parameter value rlpbrt does not understand (an error with --strict).
 void warn(const ParamList& ps, const std::string& name, const std::string& msg) {
     if (Diagnostics* d = ps.diagnostics()) {
         const Param* p = ps.find(name);
-        d->warning(p ? p->loc : FileLoc{}, msg);
+        d->substituted(p ? p->loc : FileLoc{}, msg);
     }
+}
+
+std::string formatFloat(float v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
 }
 
 bool hasExtension(const std::string& filename, const char* ext) {
@@ -467,8 +478,18 @@ TexPtr<T> makeImageTexture(const ParamList& ps, const Mat4& worldFromTexture,
     key.gamma = ps.getBool("gamma", key.gamma);
 
     MipMapCache local;
-    auto map = getMipMap<T>(cache ? *cache : local, key, error);
-    if (!map) return nullptr;
+    std::string readError;
+    auto map = getMipMap<T>(cache ? *cache : local, key, &readError);
+    if (!map) {
+        // pbrt-v3 reports the unreadable image and uses a one-texel map of value "scale".
+        if (Diagnostics* d = ps.diagnostics()) {
+            const Param* f = ps.find("filename");
+            d->substituted(f ? f->loc : FileLoc{},
+                           readError + "; using the constant " + formatFloat(key.scale) +
+                               " (\"scale\") instead (as pbrt-v3)");
+        }
+        return std::make_shared<typename ConstantOf<T>::Type>(T(key.scale));
+    }
     return std::make_shared<ImageTexture<T>>(std::move(mapping), std::move(map), filter,
                                              maxAniso);
 }
@@ -541,8 +562,15 @@ TexPtr<T> createCommon(const std::string& type, const ParamList& ps, const Mat4&
                                                  makeMapping3D(worldFromTexture), 0, 0.f);
     }
     if (type == "ptex") {
-        if (error) *error = "texture type \"ptex\" is not supported";
-        return nullptr;
+        // No Ptex library in Debian 12: a constant grey stands in (an error with --strict).
+        ps.markAllUsed();
+        if (Diagnostics* d = ps.diagnostics()) {
+            const Param* f = ps.find("filename");
+            d->ignored(f ? f->loc : FileLoc{},
+                       "texture type \"ptex\" is not supported (no Ptex library); a constant "
+                       "0.5 is used instead");
+        }
+        return std::make_shared<typename ConstantOf<T>::Type>(T(0.5f));
     }
     *known = false;
     return nullptr;

@@ -4,7 +4,9 @@
 // the scene itself) and a substring of its message; an empty file must parse without error.
 // Files directly in tests/data/bad/ hold syntax errors and are parsed in-process; files in
 // tests/data/bad/semantic/ hold errors found by the scene builder and are run through the
-// CLI (`rlpbrt --parse-only`). Files under inc/ are helpers included by the cases.
+// CLI (`rlpbrt --parse-only`); files in tests/data/bad/strict/ hold input that pbrt-v3
+// tolerates with a substitute: an error with --strict, a warning at the same place without.
+// Files under inc/ are helpers included by the cases.
 #include "parser/parser.h"
 
 #include <gtest/gtest.h>
@@ -132,11 +134,13 @@ INSTANTIATE_TEST_SUITE_P(Corpus, BadSyntax, ::testing::ValuesIn(corpusFiles(corp
 TEST(BadInputCorpus, HasEnoughCases) {
     auto syntax = corpusFiles(corpusDir());
     auto semantic = corpusFiles(corpusDir() + "/semantic");
+    auto strict = corpusFiles(corpusDir() + "/strict");
     EXPECT_GE(syntax.size(), 30u);
     EXPECT_GE(semantic.size(), 20u);
+    EXPECT_GE(strict.size(), 3u);
     // Every case names a distinct expectation (no accidental duplicates).
     std::vector<std::string> specs;
-    for (const auto& list : {syntax, semantic})
+    for (const auto& list : {syntax, semantic, strict})
         for (const auto& f : list) {
             Expectation e;
             ASSERT_TRUE(readExpectation(f, &e));
@@ -237,10 +241,10 @@ struct RunResult {
 };
 
 // Runs `rlpbrt --parse-only <scene>` with a time limit; stdout is discarded.
-RunResult runCli(const std::string& scene) {
+RunResult runCli(const std::string& scene, const std::string& flags = "") {
     RunResult r;
-    std::string cmd = "timeout -k 5 120 '" + std::string(RLPBRT_BINARY) + "' --parse-only '" +
-                      scene + "' 2>&1 >/dev/null";
+    std::string cmd = "timeout -k 5 120 '" + std::string(RLPBRT_BINARY) + "' --parse-only " +
+                      flags + " '" + scene + "' 2>&1 >/dev/null";
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return r;
     char buf[4096];
@@ -252,8 +256,9 @@ RunResult runCli(const std::string& scene) {
 }
 
 // Every "file:line:col: error: message" line of CLI output as (canonical location, message).
-std::vector<std::pair<std::string, std::string>> cliErrors(const std::string& output) {
-    static const std::regex re(R"(^(.+):(\d+):(\d+): error: (.*)$)");
+std::vector<std::pair<std::string, std::string>> cliErrors(const std::string& output,
+                                                           const std::string& kind = "error") {
+    const std::regex re("^(.+):(\\d+):(\\d+): " + kind + ": (.*)$");
     std::vector<std::pair<std::string, std::string>> out;
     std::size_t start = 0;
     while (start < output.size()) {
@@ -298,6 +303,37 @@ TEST_P(BadSemantics, CliReportsTheFirstErrorAndFails) {
 
 INSTANTIATE_TEST_SUITE_P(Corpus, BadSemantics,
                          ::testing::ValuesIn(corpusFiles(corpusDir() + "/semantic")), testName);
+
+class StrictSubstitutes : public ::testing::TestWithParam<std::string> {};
+
+// pbrt-v3's tolerance: a located warning and a scene that builds; with --strict the same
+// place is the first error and the exit status is non-zero.
+TEST_P(StrictSubstitutes, WarningWithoutStrictErrorWithStrict) {
+    if (!haveCli()) GTEST_SKIP() << RLPBRT_BINARY << " not built";
+    const std::string& path = GetParam();
+    Expectation e;
+    ASSERT_TRUE(readExpectation(path, &e));
+    ASSERT_FALSE(e.ok) << "strict cases must expect an error";
+    const std::string loc = e.file + ":" + std::to_string(e.line) + ":" + std::to_string(e.col);
+    for (bool strict : {false, true}) {
+        SCOPED_TRACE(strict ? "--strict" : "tolerant");
+        RunResult r = runCli(path, strict ? "--strict" : "");
+        ASSERT_NE(r.exitCode, -1) << "crashed:\n" << r.output;
+        ASSERT_LT(r.exitCode, 124) << r.output;
+        EXPECT_EQ(r.exitCode, strict ? 1 : 0) << r.output;
+        auto found = cliErrors(r.output, strict ? "error" : "warning");
+        ASSERT_FALSE(found.empty()) << r.output;
+        EXPECT_EQ(found[0].first, loc) << r.output;
+        EXPECT_NE(found[0].second.find(e.text), std::string::npos)
+            << "message: " << found[0].second << "\nexpected to contain: " << e.text;
+        if (!strict) {
+            EXPECT_TRUE(cliErrors(r.output).empty()) << r.output;
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Corpus, StrictSubstitutes,
+                         ::testing::ValuesIn(corpusFiles(corpusDir() + "/strict")), testName);
 
 TEST(BadSyntaxCli, ParserErrorsReachTheCli) {
     if (!haveCli()) GTEST_SKIP() << RLPBRT_BINARY << " not built";

@@ -378,9 +378,10 @@ TEST(Textures, FactoryErrors) {
     TestResolver r;
     std::string err;
     ParamList empty;
-    EXPECT_FALSE(createFloatTexture("ptex", empty, Mat4(1.f), r, &err));
-    EXPECT_NE(err.find("ptex"), std::string::npos);
-    err.clear();
+    // ptex (no library): a constant 0.5 with a warning (Textures.UnreadableImage... style).
+    auto ptex = createFloatTexture("ptex", empty, Mat4(1.f), r, &err);
+    ASSERT_NE(ptex, nullptr);
+    EXPECT_EQ(ptex->evaluate(TextureContext()), 0.5f);
     EXPECT_FALSE(createSpectrumTexture("bogus", empty, Mat4(1.f), r, &err));
     EXPECT_NE(err.find("bogus"), std::string::npos);
     err.clear();
@@ -391,9 +392,32 @@ TEST(Textures, FactoryErrors) {
     EXPECT_FALSE(createSpectrumTexture("uv", badMap, Mat4(1.f), r, &err));
     EXPECT_NE(err.find("toroidal"), std::string::npos);
     err.clear();
-    ParamList missing = makeParams({stringParam("filename", "/nonexistent/nothing.png")});
-    EXPECT_FALSE(createSpectrumTexture("imagemap", missing, Mat4(1.f), r, &err));
-    EXPECT_FALSE(err.empty());
+}
+
+// pbrt-v3's substitute for an unreadable image: a constant of value "scale", with a warning
+// at the "filename" parameter (an error in strict mode).
+TEST(Textures, UnreadableImageIsTheConstantScale) {
+    for (bool strict : {false, true}) {
+        Diagnostics diag;
+        diag.setStream(nullptr);
+        diag.setStrict(strict);
+        ParamList ps = makeParams({stringParam("filename", "/nonexistent/nothing.png"),
+                                   floatParam("scale", 0.25f)});
+        ps.setDiagnostics(&diag);
+        TestResolver r;
+        std::string err;
+        auto t = createSpectrumTexture("imagemap", ps, Mat4(1.f), r, &err);
+        ASSERT_NE(t, nullptr) << err;
+        TextureContext tc;
+        tc.uv = Vec2(0.3f, 0.7f);
+        EXPECT_EQ(t->evaluate(tc), Spectrum(0.25f));
+        auto f = createFloatTexture("imagemap", ps, Mat4(1.f), r, &err);
+        ASSERT_NE(f, nullptr) << err;
+        EXPECT_EQ(f->evaluate(tc), 0.25f);
+        ASSERT_FALSE(diag.all().empty());
+        EXPECT_EQ(diag.all()[0].severity, strict ? Severity::Error : Severity::Warning);
+        EXPECT_NE(diag.all()[0].message.find("nothing.png"), std::string::npos);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
