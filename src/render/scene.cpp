@@ -76,6 +76,59 @@ void quadricOccluded(const RTCOccludedFunctionNArguments* args) {
     if (quadricHit(q, o, d, ray->tnear, ray->tfar, &hit)) ray->tfar = -Infinity;
 }
 
+// ------------------------------------------------------------------------------------------
+// Curves as Embree user geometry: one primitive per curve piece (CurveShape::primitive), our
+// own intersection test (curves.h says why not Embree's native curves).
+
+void curvePrimBounds(const RTCBoundsFunctionArguments* args) {
+    const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
+    Vec3 lo, hi;
+    curveBounds(*c, args->primID, &lo, &hi);
+    Vec3 bmin(Infinity), bmax(-Infinity);
+    for (int k = 0; k < 8; ++k) {
+        Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+        Vec3 w = transformPoint(c->worldFromObject, corner);
+        bmin = glm::min(bmin, w);
+        bmax = glm::max(bmax, w);
+    }
+    Vec3 pad = 1e-5f * (glm::abs(bmin) + glm::abs(bmax)) + Vec3(1e-7f);
+    args->bounds_o->lower_x = bmin.x - pad.x;
+    args->bounds_o->lower_y = bmin.y - pad.y;
+    args->bounds_o->lower_z = bmin.z - pad.z;
+    args->bounds_o->upper_x = bmax.x + pad.x;
+    args->bounds_o->upper_y = bmax.y + pad.y;
+    args->bounds_o->upper_z = bmax.z + pad.z;
+}
+
+void curvePrimIntersect(const RTCIntersectFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    Vec3 o = transformPoint(c->objectFromWorld, Vec3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z));
+    Vec3 d = transformVector(c->objectFromWorld, Vec3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z));
+    CurveHit hit;
+    if (!intersectCurve(*c, args->primID, o, d, rh->ray.tfar, &hit)) return;
+    if (!(hit.t > rh->ray.tnear)) return;
+    rh->ray.tfar = hit.t;
+    rh->hit.u = hit.uv.x;
+    rh->hit.v = hit.uv.y;
+    rh->hit.Ng_x = hit.n.x;
+    rh->hit.Ng_y = hit.n.y;
+    rh->hit.Ng_z = hit.n.z;
+    rh->hit.primID = args->primID;
+    rh->hit.geomID = args->geomID;
+    rh->hit.instID[0] = args->context->instID[0];
+}
+
+void curvePrimOccluded(const RTCOccludedFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
+    auto* ray = reinterpret_cast<RTCRay*>(args->ray);
+    Vec3 o = transformPoint(c->objectFromWorld, Vec3(ray->org_x, ray->org_y, ray->org_z));
+    Vec3 d = transformVector(c->objectFromWorld, Vec3(ray->dir_x, ray->dir_y, ray->dir_z));
+    if (intersectCurve(*c, args->primID, o, d, ray->tfar, nullptr)) ray->tfar = -Infinity;
+}
+
 // Builds a coordinate system (dpdu, dpdv) around n when the parametrisation is degenerate.
 void coordinateSystem(const Vec3& n, Vec3* a, Vec3* b) {
     Frame f = Frame::fromZ(n);
@@ -209,6 +262,31 @@ void Scene::hitDetails(const Primitive& prim, unsigned primID, float u, float v,
         si->ng = ng;
         si->ns = ns;
         if (prim.lightBase >= 0) si->light = prim.lightBase + int(primID);
+    } else if (const CurveShape* c = prim.shape.curve.get()) {
+        // Recompute the hit in object space for its local geometry (pbrt-v3's point on the
+        // ray at the depth of the curve's centre line).
+        Vec3 o = ray.o, d = ray.d;
+        if (inst) {
+            o = transformPoint(inst->instanceFromWorld, o);
+            d = transformVector(inst->instanceFromWorld, d);
+        }
+        Vec3 oo = transformPoint(c->objectFromWorld, o);
+        Vec3 od = transformVector(c->objectFromWorld, d);
+        CurveHit hit;
+        bool found = intersectCurve(*c, primID, oo, od, t * (1.f + 1e-4f) + 1e-30f, &hit) ||
+                     intersectCurve(*c, primID, oo, od, Infinity, &hit);
+        si->p = o + t * d;
+        Vec3 n = found ? glm::normalize(transformNormal(c->objectFromWorld, hit.n)) : Vec3(0.f);
+        if (!isFinite(n) || glm::dot(n, n) == 0.f) {
+            n = -glm::normalize(d);
+            coordinateSystem(n, &si->dpdu, &si->dpdv);
+            si->uv = Vec2(0.f, 0.5f);
+        } else {
+            si->uv = hit.uv;
+            si->dpdu = transformVector(c->worldFromObject, hit.dpdu);
+            si->dpdv = transformVector(c->worldFromObject, hit.dpdv);
+        }
+        si->ng = si->ns = n;
     } else {
         const QuadricShape* q = prim.shape.quadric.get();
         // Recompute the hit in object space for the full local geometry.
@@ -319,6 +397,7 @@ bool Scene::sampleGroup(int group, const Vec3& u, Vec3* p, Vec3* n) const {
         *n = c / len;
         return true;
     }
+    if (!prim.shape.quadric) return false;
     const QuadricShape& q = *prim.shape.quadric;
     QuadricSample qs;
     if (!sampleArea(q.quadric, Vec2(ur, u.y), &qs)) return false;
@@ -442,6 +521,13 @@ public:
                 rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                         3 * sizeof(uint32_t), m->triangleCount()));
             std::memcpy(ib, m->indices.data(), m->indices.size() * sizeof(uint32_t));
+        } else if (prim.shape.curve) {
+            g = rtcNewGeometry(s_.device_, RTC_GEOMETRY_TYPE_USER);
+            rtcSetGeometryUserPrimitiveCount(g, unsigned(prim.shape.curve->primitiveCount()));
+            rtcSetGeometryUserData(g, prim.shape.curve.get());
+            rtcSetGeometryBoundsFunction(g, curvePrimBounds, nullptr);
+            rtcSetGeometryIntersectFunction(g, curvePrimIntersect);
+            rtcSetGeometryOccludedFunction(g, curvePrimOccluded);
         } else {
             g = rtcNewGeometry(s_.device_, RTC_GEOMETRY_TYPE_USER);
             rtcSetGeometryUserPrimitiveCount(g, 1);
@@ -625,7 +711,10 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         prim.material = materialIndexFor(desc, e.material, runtimeMaterial);
         prim.mediumInside = mediumByName(e.insideMedium);
         prim.mediumOutside = mediumByName(e.outsideMedium);
-        if (allowLights && e.areaLight >= 0) {
+        if (allowLights && e.areaLight >= 0 && prim.shape.curve) {
+            diag.warning(e.loc, "an area light on a curve is not supported (pbrt-v3 cannot "
+                                "sample curves either); the curve does not emit");
+        } else if (allowLights && e.areaLight >= 0) {
             const Entity& al = desc.areaLights[size_t(e.areaLight)];
             std::vector<std::unique_ptr<Light>> made;
             if (createAreaLights(al.type, al.params, prim.shape, al.loc, diag, &made) &&
@@ -637,6 +726,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         }
         s.stats.shapes++;
         if (prim.shape.mesh) s.stats.triangles += prim.shape.mesh->triangleCount();
+        else if (prim.shape.curve) s.stats.curves += prim.shape.curve->segments.size();
         else s.stats.quadrics++;
         group.prims.push_back(std::move(prim));
     };

@@ -282,7 +282,11 @@ bool createShape(const ShapeEntity& e, Diagnostics& diag, ShapeData* out) {
         auto q = std::make_shared<QuadricShape>();
         ok = makeQuadric(e, diag, q.get());
         if (ok) out->quadric = std::move(q);
-    } else if (e.type == "curve" || e.type == "nurbs") {
+    } else if (e.type == "curve") {
+        auto c = std::make_shared<CurveShape>();
+        ok = makeCurveShape(e, diag, c.get());
+        if (ok) out->curve = std::move(c);
+    } else if (e.type == "nurbs") {
         e.params.markAllUsed();
         diag.ignored(e.loc, "shape \"" + e.type + "\" is not supported; it is skipped");
         return false;

@@ -1,7 +1,7 @@
 // Correctness against pbrt-v3: every scene of ../shared/references/manifest.tsv (surface
-// scenes, and the media=1 scenes rendered with volpath semantics) is rendered at 64 spp
-// (fixed seed) with every guiding backend (none, hemi, vdb) and compared with pbrt-v3's
-// reference.
+// scenes, and the media=1 scenes rendered with volpath semantics), and the feature scenes of
+// ../shared/references/features/manifest.tsv, are rendered at 64 spp (fixed seed) with every
+// guiding backend (none, hemi, vdb) and compared with pbrt-v3's reference.
 // Bounds (issue "path tracer" acceptance): relMSE <= 1.5x pbrt-v3's own 64-spp relMSE;
 // median block deviation <= max(2%, 1.5x pbrt-v3's own 64-spp figure); no NaN/Inf.
 #include <fstream>
@@ -25,9 +25,12 @@ struct ManifestRow {
     bool media = false;
 };
 
-std::vector<ManifestRow> readManifest() {
+// `dir`: the references' folder under ../shared ("references", or "references/features" for
+// the per-feature scenes of ../shared/scenes/pbrt-features), holding manifest.tsv and the
+// images.
+std::vector<ManifestRow> readManifest(const std::string& dir = "references") {
     std::vector<ManifestRow> rows;
-    std::ifstream f(test::sharedDir() + "/references/manifest.tsv");
+    std::ifstream f(test::sharedDir() + "/" + dir + "/manifest.tsv");
     std::string line;
     std::getline(f, line);  // header
     while (std::getline(f, line)) {
@@ -67,8 +70,9 @@ class ReferenceTest
 class MediaReferenceTest : public ReferenceTest {};
 
 void checkAgainstPbrtV3(const std::string& id, const char* guide, bool media,
-                        const std::map<std::string, std::string>& params = {}) {
-    std::vector<ManifestRow> rows = readManifest();
+                        const std::map<std::string, std::string>& params = {},
+                        const std::string& dir = "references") {
+    std::vector<ManifestRow> rows = readManifest(dir);
     const ManifestRow* row = nullptr;
     for (const auto& r : rows)
         if (r.id == id) row = &r;
@@ -101,7 +105,7 @@ void checkAgainstPbrtV3(const std::string& id, const char* guide, bool media,
 
     Image ref;
     std::string err;
-    ASSERT_TRUE(readImage(test::sharedDir() + "/references/" + row->id + ".exr", &ref, &err))
+    ASSERT_TRUE(readImage(test::sharedDir() + "/" + dir + "/" + row->id + ".exr", &ref, &err))
         << err;
     ASSERT_EQ(result.image.width, ref.width);
     ASSERT_EQ(result.image.height, ref.height);
@@ -136,6 +140,16 @@ TEST(ReferenceLearnBudget, FrozenGuideMatchesPbrtV3At64spp) {
         checkAgainstPbrtV3(id, "hemi", false, {{"learn", "16"}});
     }
 }
+
+// The per-feature scenes (../shared/references/features): the "curve" shape (flat, cylinder
+// and ribbon), same bounds, every backend.
+class CurvesReferenceTest : public ::testing::TestWithParam<const char*> {};
+TEST_P(CurvesReferenceTest, MatchesPbrtV3At64spp) {
+    RLPBRT_REQUIRE_SHARED();
+    checkAgainstPbrtV3("pbrt-features__curves", GetParam(), false, {}, "references/features");
+}
+std::string guideName(const ::testing::TestParamInfo<const char*>& info) { return info.param; }
+INSTANTIATE_TEST_SUITE_P(Guides, CurvesReferenceTest, ::testing::ValuesIn(kGuides), guideName);
 
 std::string sceneTestName(const ::testing::TestParamInfo<std::tuple<const char*, const char*>>& info) {
     std::string n = std::string(std::get<0>(info.param)) + "_" + std::get<1>(info.param);
