@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "render/hair.h"
+
 namespace rlpbrt {
 
 Material::~Material() = default;
@@ -309,7 +311,9 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
             ms[i] = materials[size_t(names.rend() - it - 1)];
         }
         m = std::make_unique<MixMaterial>(ms[0], ms[1], tex.spectrumTex(p, "amount", Spectrum(0.5f)));
-    } else if (t == "fourier" || t == "hair" || t == "disney" || t == "subsurface" ||
+    } else if (t == "hair") {
+        m = createHairMaterial(e, tex, diag);
+    } else if (t == "fourier" || t == "disney" || t == "subsurface" ||
                t == "kdsubsurface") {
         p.markAllUsed();
         diag.ignored(e.loc, "material \"" + t + "\" is not supported; rendered as matte "

@@ -151,6 +151,14 @@ TEST_P(CurvesReferenceTest, MatchesPbrtV3At64spp) {
 std::string guideName(const ::testing::TestParamInfo<const char*>& info) { return info.param; }
 INSTANTIATE_TEST_SUITE_P(Guides, CurvesReferenceTest, ::testing::ValuesIn(kGuides), guideName);
 
+// The "hair" material on 400 cylinder curves (absorption given as sigma_a and as pigments).
+class HairReferenceTest : public ::testing::TestWithParam<const char*> {};
+TEST_P(HairReferenceTest, MatchesPbrtV3At64spp) {
+    RLPBRT_REQUIRE_SHARED();
+    checkAgainstPbrtV3("pbrt-features__hair", GetParam(), false, {}, "references/features");
+}
+INSTANTIATE_TEST_SUITE_P(Guides, HairReferenceTest, ::testing::ValuesIn(kGuides), guideName);
+
 std::string sceneTestName(const ::testing::TestParamInfo<std::tuple<const char*, const char*>>& info) {
     std::string n = std::string(std::get<0>(info.param)) + "_" + std::get<1>(info.param);
     for (char& c : n)
