@@ -19,25 +19,46 @@ namespace rlpbrt {
 
 namespace {
 
+// User geometry's bounds: the object-space box [lo, hi] carried to the world, padded by a
+// relative epsilon so that float rounding cannot cut off a hit.
+void setWorldBounds(const Mat4& worldFromObject, const Vec3& lo, const Vec3& hi,
+                    RTCBounds* out) {
+    Vec3 bmin(Infinity), bmax(-Infinity);
+    for (int c = 0; c < 8; ++c) {
+        Vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        Vec3 w = transformPoint(worldFromObject, corner);
+        bmin = glm::min(bmin, w);
+        bmax = glm::max(bmax, w);
+    }
+    Vec3 pad = 1e-5f * (glm::abs(bmin) + glm::abs(bmax)) + Vec3(1e-7f);
+    out->lower_x = bmin.x - pad.x;
+    out->lower_y = bmin.y - pad.y;
+    out->lower_z = bmin.z - pad.z;
+    out->upper_x = bmax.x + pad.x;
+    out->upper_y = bmax.y + pad.y;
+    out->upper_z = bmax.z + pad.z;
+}
+
+// Records a user geometry's closest hit so far.
+void setUserHit(const RTCIntersectFunctionNArguments* args, float t, const Vec2& uv,
+                const Vec3& n) {
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    rh->ray.tfar = t;
+    rh->hit.u = uv.x;
+    rh->hit.v = uv.y;
+    rh->hit.Ng_x = n.x;
+    rh->hit.Ng_y = n.y;
+    rh->hit.Ng_z = n.z;
+    rh->hit.primID = args->primID;
+    rh->hit.geomID = args->geomID;
+    rh->hit.instID[0] = args->context->instID[0];
+}
+
 void quadricBounds(const RTCBoundsFunctionArguments* args) {
     const auto* q = static_cast<const QuadricShape*>(args->geometryUserPtr);
     Vec3 lo, hi;
     bounds(q->quadric, &lo, &hi);
-    Vec3 bmin(Infinity), bmax(-Infinity);
-    for (int c = 0; c < 8; ++c) {
-        Vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-        Vec3 w = transformPoint(q->worldFromObject, corner);
-        bmin = glm::min(bmin, w);
-        bmax = glm::max(bmax, w);
-    }
-    // Pad by a relative epsilon so that float rounding cannot cut off a hit.
-    Vec3 pad = 1e-5f * (glm::abs(bmin) + glm::abs(bmax)) + Vec3(1e-7f);
-    args->bounds_o->lower_x = bmin.x - pad.x;
-    args->bounds_o->lower_y = bmin.y - pad.y;
-    args->bounds_o->lower_z = bmin.z - pad.z;
-    args->bounds_o->upper_x = bmax.x + pad.x;
-    args->bounds_o->upper_y = bmax.y + pad.y;
-    args->bounds_o->upper_z = bmax.z + pad.z;
+    setWorldBounds(q->worldFromObject, lo, hi, args->bounds_o);
 }
 
 bool quadricHit(const QuadricShape* q, const Vec3& o, const Vec3& d, float tnear, float tfar,
@@ -55,15 +76,7 @@ void quadricIntersect(const RTCIntersectFunctionNArguments* args) {
     Vec3 d(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
     QuadricHit hit;
     if (!quadricHit(q, o, d, rh->ray.tnear, rh->ray.tfar, &hit)) return;
-    rh->ray.tfar = hit.t;
-    rh->hit.u = hit.uv.x;
-    rh->hit.v = hit.uv.y;
-    rh->hit.Ng_x = hit.n.x;
-    rh->hit.Ng_y = hit.n.y;
-    rh->hit.Ng_z = hit.n.z;
-    rh->hit.primID = args->primID;
-    rh->hit.geomID = args->geomID;
-    rh->hit.instID[0] = args->context->instID[0];
+    setUserHit(args, hit.t, hit.uv, hit.n);
 }
 
 void quadricOccluded(const RTCOccludedFunctionNArguments* args) {
@@ -84,20 +97,7 @@ void curvePrimBounds(const RTCBoundsFunctionArguments* args) {
     const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
     Vec3 lo, hi;
     curveBounds(*c, args->primID, &lo, &hi);
-    Vec3 bmin(Infinity), bmax(-Infinity);
-    for (int k = 0; k < 8; ++k) {
-        Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
-        Vec3 w = transformPoint(c->worldFromObject, corner);
-        bmin = glm::min(bmin, w);
-        bmax = glm::max(bmax, w);
-    }
-    Vec3 pad = 1e-5f * (glm::abs(bmin) + glm::abs(bmax)) + Vec3(1e-7f);
-    args->bounds_o->lower_x = bmin.x - pad.x;
-    args->bounds_o->lower_y = bmin.y - pad.y;
-    args->bounds_o->lower_z = bmin.z - pad.z;
-    args->bounds_o->upper_x = bmax.x + pad.x;
-    args->bounds_o->upper_y = bmax.y + pad.y;
-    args->bounds_o->upper_z = bmax.z + pad.z;
+    setWorldBounds(c->worldFromObject, lo, hi, args->bounds_o);
 }
 
 void curvePrimIntersect(const RTCIntersectFunctionNArguments* args) {
@@ -109,15 +109,7 @@ void curvePrimIntersect(const RTCIntersectFunctionNArguments* args) {
     CurveHit hit;
     if (!intersectCurve(*c, args->primID, o, d, rh->ray.tfar, &hit)) return;
     if (!(hit.t > rh->ray.tnear)) return;
-    rh->ray.tfar = hit.t;
-    rh->hit.u = hit.uv.x;
-    rh->hit.v = hit.uv.y;
-    rh->hit.Ng_x = hit.n.x;
-    rh->hit.Ng_y = hit.n.y;
-    rh->hit.Ng_z = hit.n.z;
-    rh->hit.primID = args->primID;
-    rh->hit.geomID = args->geomID;
-    rh->hit.instID[0] = args->context->instID[0];
+    setUserHit(args, hit.t, hit.uv, hit.n);
 }
 
 void curvePrimOccluded(const RTCOccludedFunctionNArguments* args) {
@@ -360,6 +352,10 @@ void Scene::buildAreaTables() const {
             } else if (prim.shape.quadric) {
                 a = quadricWorldArea(*prim.shape.quadric);
             }
+            // Curves place no guiding data (area 0): a curve hit's normal faces the ray (flat)
+            // or is turned across the band (cylinder), so no region keyed by a surface normal
+            // describes it; hair, their main use, is glossy and left to its BSDF anyway; and
+            // pbrt-v3 cannot sample a curve's area either. docs/ARCHITECTURE.md, "Guiding".
             if (!std::isfinite(a)) a = 0.0;
             primAreas.push_back(float(a));
             t.area += a;
