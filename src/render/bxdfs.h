@@ -272,6 +272,27 @@ struct FourierBSDF {
     }
 };
 
+// pbrt-v3's HairBSDF (d'Eon et al. 2011, Chiang et al. 2016; hair.cpp): R, TT, TRT and a
+// remainder lobe of a rough dielectric cylinder with absorbing interior and tilted scales.
+// Local frame: x along the hair (the curve's dpdu), z the shading normal; h in [-1, 1] is the
+// offset across the hair (-1 + 2 v on a curve). Flags: glossy, reflection and transmission
+// (a sample reports the side it went to).
+struct HairBxDF {
+    float h, gammaO, eta;
+    Spectrum sigmaA;
+    float v0;                  // longitudinal variance of R; TT: v0 / 4; TRT and beyond: 4 v0
+    float s;                   // azimuthal logistic scale
+    float sinAlpha, cosAlpha;  // the scales' tilt
+    HairBxDF(float h, float eta, const Spectrum& sigmaA, float betaM, float betaN,
+             float alphaDegrees);
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const {
+        return BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Glossy;
+    }
+};
+
 // Any one lobe, stored by value.
 class BxDF {
   public:
@@ -279,7 +300,7 @@ class BxDF {
         std::variant<LambertianReflection, LambertianTransmission, OrenNayar,
                      SpecularReflection, SpecularTransmission, FresnelSpecular,
                      MicrofacetReflection, MicrofacetTransmission, FresnelBlend,
-                     DisneyDiffuseLobe, DisneyClearcoat, FourierBSDF>;
+                     DisneyDiffuseLobe, DisneyClearcoat, FourierBSDF, HairBxDF>;
 
     // A black Lambertian reflection lobe.
     BxDF() = default;

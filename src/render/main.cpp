@@ -34,8 +34,8 @@ extern "C" void onSignal(int) { gCancel.store(true); }
 void printSummary(const SceneDesc& desc, const Scene& scene, const Diagnostics& diag,
                   double parseSec, double buildSec) {
     const SceneStats& s = scene.stats;
-    std::printf("shapes: %zu (%zu triangles in meshes, %zu quadrics)\n", s.shapes, s.triangles,
-                s.quadrics);
+    std::printf("shapes: %zu (%zu triangles in meshes, %zu quadrics, %zu curve segments)\n",
+                s.shapes, s.triangles, s.quadrics, s.curves);
     std::printf("instances: %zu of %zu objects (%zu instanced triangles)\n", s.instances,
                 desc.objects.size(), s.instancedTriangles);
     std::printf("lights: %zu (%zu area lights, %zu other)\n", s.lights, s.areaLights,

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "render/fourier_bsdf.h"
+#include "render/hair.h"
 
 namespace rlpbrt {
 
@@ -400,7 +401,9 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
             table.reset();
         }
         m = std::make_unique<FourierMaterial>(std::move(table), bump);
-    } else if (t == "hair" || t == "subsurface" || t == "kdsubsurface") {
+    } else if (t == "hair") {
+        m = createHairMaterial(e, tex, diag);
+    } else if (t == "subsurface" || t == "kdsubsurface") {
         p.markAllUsed();
         diag.ignored(e.loc, "material \"" + t + "\" is not supported; rendered as matte "
                             "(Kd 0.5) instead");

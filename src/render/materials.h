@@ -1,6 +1,7 @@
 // Materials with pbrt-v3's semantics: they evaluate their textures at a surface point and set
 // up a BSDF (bsdf.h). Types: matte, plastic, metal, glass, mirror, uber, substrate,
-// translucent, mix, disney, fourier; "" / "none" / "interface" mark medium boundaries (no Material object).
+// translucent, mix, disney, fourier, hair (hair.h); "" / "none" / "interface" mark medium
+// boundaries (no Material object).
 #pragma once
 
 #include <memory>

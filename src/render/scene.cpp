@@ -19,25 +19,46 @@ namespace rlpbrt {
 
 namespace {
 
+// User geometry's bounds: the object-space box [lo, hi] carried to the world, padded by a
+// relative epsilon so that float rounding cannot cut off a hit.
+void setWorldBounds(const Mat4& worldFromObject, const Vec3& lo, const Vec3& hi,
+                    RTCBounds* out) {
+    Vec3 bmin(Infinity), bmax(-Infinity);
+    for (int c = 0; c < 8; ++c) {
+        Vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        Vec3 w = transformPoint(worldFromObject, corner);
+        bmin = glm::min(bmin, w);
+        bmax = glm::max(bmax, w);
+    }
+    Vec3 pad = 1e-5f * (glm::abs(bmin) + glm::abs(bmax)) + Vec3(1e-7f);
+    out->lower_x = bmin.x - pad.x;
+    out->lower_y = bmin.y - pad.y;
+    out->lower_z = bmin.z - pad.z;
+    out->upper_x = bmax.x + pad.x;
+    out->upper_y = bmax.y + pad.y;
+    out->upper_z = bmax.z + pad.z;
+}
+
+// Records a user geometry's closest hit so far.
+void setUserHit(const RTCIntersectFunctionNArguments* args, float t, const Vec2& uv,
+                const Vec3& n) {
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    rh->ray.tfar = t;
+    rh->hit.u = uv.x;
+    rh->hit.v = uv.y;
+    rh->hit.Ng_x = n.x;
+    rh->hit.Ng_y = n.y;
+    rh->hit.Ng_z = n.z;
+    rh->hit.primID = args->primID;
+    rh->hit.geomID = args->geomID;
+    rh->hit.instID[0] = args->context->instID[0];
+}
+
 void quadricBounds(const RTCBoundsFunctionArguments* args) {
     const auto* q = static_cast<const QuadricShape*>(args->geometryUserPtr);
     Vec3 lo, hi;
     bounds(q->quadric, &lo, &hi);
-    Vec3 bmin(Infinity), bmax(-Infinity);
-    for (int c = 0; c < 8; ++c) {
-        Vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-        Vec3 w = transformPoint(q->worldFromObject, corner);
-        bmin = glm::min(bmin, w);
-        bmax = glm::max(bmax, w);
-    }
-    // Pad by a relative epsilon so that float rounding cannot cut off a hit.
-    Vec3 pad = 1e-5f * (glm::abs(bmin) + glm::abs(bmax)) + Vec3(1e-7f);
-    args->bounds_o->lower_x = bmin.x - pad.x;
-    args->bounds_o->lower_y = bmin.y - pad.y;
-    args->bounds_o->lower_z = bmin.z - pad.z;
-    args->bounds_o->upper_x = bmax.x + pad.x;
-    args->bounds_o->upper_y = bmax.y + pad.y;
-    args->bounds_o->upper_z = bmax.z + pad.z;
+    setWorldBounds(q->worldFromObject, lo, hi, args->bounds_o);
 }
 
 bool quadricHit(const QuadricShape* q, const Vec3& o, const Vec3& d, float tnear, float tfar,
@@ -55,15 +76,7 @@ void quadricIntersect(const RTCIntersectFunctionNArguments* args) {
     Vec3 d(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
     QuadricHit hit;
     if (!quadricHit(q, o, d, rh->ray.tnear, rh->ray.tfar, &hit)) return;
-    rh->ray.tfar = hit.t;
-    rh->hit.u = hit.uv.x;
-    rh->hit.v = hit.uv.y;
-    rh->hit.Ng_x = hit.n.x;
-    rh->hit.Ng_y = hit.n.y;
-    rh->hit.Ng_z = hit.n.z;
-    rh->hit.primID = args->primID;
-    rh->hit.geomID = args->geomID;
-    rh->hit.instID[0] = args->context->instID[0];
+    setUserHit(args, hit.t, hit.uv, hit.n);
 }
 
 void quadricOccluded(const RTCOccludedFunctionNArguments* args) {
@@ -74,6 +87,38 @@ void quadricOccluded(const RTCOccludedFunctionNArguments* args) {
     Vec3 d(ray->dir_x, ray->dir_y, ray->dir_z);
     QuadricHit hit;
     if (quadricHit(q, o, d, ray->tnear, ray->tfar, &hit)) ray->tfar = -Infinity;
+}
+
+// ------------------------------------------------------------------------------------------
+// Curves as Embree user geometry: one primitive per curve piece (CurveShape::primitive), our
+// own intersection test (curves.h says why not Embree's native curves).
+
+void curvePrimBounds(const RTCBoundsFunctionArguments* args) {
+    const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
+    Vec3 lo, hi;
+    curveBounds(*c, args->primID, &lo, &hi);
+    setWorldBounds(c->worldFromObject, lo, hi, args->bounds_o);
+}
+
+void curvePrimIntersect(const RTCIntersectFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    Vec3 o = transformPoint(c->objectFromWorld, Vec3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z));
+    Vec3 d = transformVector(c->objectFromWorld, Vec3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z));
+    CurveHit hit;
+    if (!intersectCurve(*c, args->primID, o, d, rh->ray.tfar, &hit)) return;
+    if (!(hit.t > rh->ray.tnear)) return;
+    setUserHit(args, hit.t, hit.uv, hit.n);
+}
+
+void curvePrimOccluded(const RTCOccludedFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    const auto* c = static_cast<const CurveShape*>(args->geometryUserPtr);
+    auto* ray = reinterpret_cast<RTCRay*>(args->ray);
+    Vec3 o = transformPoint(c->objectFromWorld, Vec3(ray->org_x, ray->org_y, ray->org_z));
+    Vec3 d = transformVector(c->objectFromWorld, Vec3(ray->dir_x, ray->dir_y, ray->dir_z));
+    if (intersectCurve(*c, args->primID, o, d, ray->tfar, nullptr)) ray->tfar = -Infinity;
 }
 
 // Builds a coordinate system (dpdu, dpdv) around n when the parametrisation is degenerate.
@@ -209,6 +254,31 @@ void Scene::hitDetails(const Primitive& prim, unsigned primID, float u, float v,
         si->ng = ng;
         si->ns = ns;
         if (prim.lightBase >= 0) si->light = prim.lightBase + int(primID);
+    } else if (const CurveShape* c = prim.shape.curve.get()) {
+        // Recompute the hit in object space for its local geometry (pbrt-v3's point on the
+        // ray at the depth of the curve's centre line).
+        Vec3 o = ray.o, d = ray.d;
+        if (inst) {
+            o = transformPoint(inst->instanceFromWorld, o);
+            d = transformVector(inst->instanceFromWorld, d);
+        }
+        Vec3 oo = transformPoint(c->objectFromWorld, o);
+        Vec3 od = transformVector(c->objectFromWorld, d);
+        CurveHit hit;
+        bool found = intersectCurve(*c, primID, oo, od, t * (1.f + 1e-4f) + 1e-30f, &hit) ||
+                     intersectCurve(*c, primID, oo, od, Infinity, &hit);
+        si->p = o + t * d;
+        Vec3 n = found ? glm::normalize(transformNormal(c->objectFromWorld, hit.n)) : Vec3(0.f);
+        if (!isFinite(n) || glm::dot(n, n) == 0.f) {
+            n = -glm::normalize(d);
+            coordinateSystem(n, &si->dpdu, &si->dpdv);
+            si->uv = Vec2(0.f, 0.5f);
+        } else {
+            si->uv = hit.uv;
+            si->dpdu = transformVector(c->worldFromObject, hit.dpdu);
+            si->dpdv = transformVector(c->worldFromObject, hit.dpdv);
+        }
+        si->ng = si->ns = n;
     } else {
         const QuadricShape* q = prim.shape.quadric.get();
         // Recompute the hit in object space for the full local geometry.
@@ -282,6 +352,10 @@ void Scene::buildAreaTables() const {
             } else if (prim.shape.quadric) {
                 a = quadricWorldArea(*prim.shape.quadric);
             }
+            // Curves place no guiding data (area 0): a curve hit's normal faces the ray (flat)
+            // or is turned across the band (cylinder), so no region keyed by a surface normal
+            // describes it; hair, their main use, is glossy and left to its BSDF anyway; and
+            // pbrt-v3 cannot sample a curve's area either. docs/ARCHITECTURE.md, "Guiding".
             if (!std::isfinite(a)) a = 0.0;
             primAreas.push_back(float(a));
             t.area += a;
@@ -319,6 +393,7 @@ bool Scene::sampleGroup(int group, const Vec3& u, Vec3* p, Vec3* n) const {
         *n = c / len;
         return true;
     }
+    if (!prim.shape.quadric) return false;
     const QuadricShape& q = *prim.shape.quadric;
     QuadricSample qs;
     if (!sampleArea(q.quadric, Vec2(ur, u.y), &qs)) return false;
@@ -442,6 +517,13 @@ public:
                 rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                         3 * sizeof(uint32_t), m->triangleCount()));
             std::memcpy(ib, m->indices.data(), m->indices.size() * sizeof(uint32_t));
+        } else if (prim.shape.curve) {
+            g = rtcNewGeometry(s_.device_, RTC_GEOMETRY_TYPE_USER);
+            rtcSetGeometryUserPrimitiveCount(g, unsigned(prim.shape.curve->primitiveCount()));
+            rtcSetGeometryUserData(g, prim.shape.curve.get());
+            rtcSetGeometryBoundsFunction(g, curvePrimBounds, nullptr);
+            rtcSetGeometryIntersectFunction(g, curvePrimIntersect);
+            rtcSetGeometryOccludedFunction(g, curvePrimOccluded);
         } else {
             g = rtcNewGeometry(s_.device_, RTC_GEOMETRY_TYPE_USER);
             rtcSetGeometryUserPrimitiveCount(g, 1);
@@ -625,7 +707,10 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         prim.material = materialIndexFor(desc, e.material, runtimeMaterial);
         prim.mediumInside = mediumByName(e.insideMedium);
         prim.mediumOutside = mediumByName(e.outsideMedium);
-        if (allowLights && e.areaLight >= 0) {
+        if (allowLights && e.areaLight >= 0 && prim.shape.curve) {
+            diag.warning(e.loc, "an area light on a curve is not supported (pbrt-v3 cannot "
+                                "sample curves either); the curve does not emit");
+        } else if (allowLights && e.areaLight >= 0) {
             const Entity& al = desc.areaLights[size_t(e.areaLight)];
             std::vector<std::unique_ptr<Light>> made;
             if (createAreaLights(al.type, al.params, prim.shape, al.loc, diag, &made) &&
@@ -637,6 +722,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
         }
         s.stats.shapes++;
         if (prim.shape.mesh) s.stats.triangles += prim.shape.mesh->triangleCount();
+        else if (prim.shape.curve) s.stats.curves += prim.shape.curve->segments.size();
         else s.stats.quadrics++;
         group.prims.push_back(std::move(prim));
     };

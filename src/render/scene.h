@@ -46,6 +46,7 @@ struct Instance {
 
 struct SceneStats {
     size_t shapes = 0, triangles = 0, quadrics = 0, instances = 0, instancedTriangles = 0;
+    size_t curves = 0;  // cubic Bezier segments of curve shapes
     size_t lights = 0, areaLights = 0, materials = 0, textures = 0;
 };
 

@@ -330,9 +330,9 @@ bool createShape(const ShapeEntity& e, Diagnostics& diag, ShapeData* out) {
         ok = makeQuadric(e, diag, q.get());
         if (ok) out->quadric = std::move(q);
     } else if (e.type == "curve") {
-        e.params.markAllUsed();
-        diag.ignored(e.loc, "shape \"" + e.type + "\" is not supported; it is skipped");
-        return false;
+        auto c = std::make_shared<CurveShape>();
+        ok = makeCurveShape(e, diag, c.get());
+        if (ok) out->curve = std::move(c);
     } else {
         diag.error(e.loc, "unknown shape type \"" + e.type + "\"");
         return false;

@@ -1,6 +1,6 @@
-// Shapes as render data: triangle meshes and analytic quadrics, made from Shape entities
-// (trianglemesh, plymesh, loopsubdiv, heightfield, nurbs, sphere, disk, cylinder, ...). No Embree
-// here: scene.cpp turns these into Embree geometry.
+// Shapes as render data: triangle meshes, analytic quadrics and curves, made from Shape
+// entities (trianglemesh, plymesh, loopsubdiv, heightfield, nurbs, sphere, disk, cylinder, curve,
+// ...). No Embree here: scene.cpp turns these into Embree geometry.
 #pragma once
 
 #include <memory>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "parser/diagnostics.h"
+#include "render/curves.h"
 #include "render/math.h"
 #include "render/quadrics.h"
 #include "render/scene_desc.h"
@@ -39,6 +40,7 @@ struct QuadricShape {
 struct ShapeData {
     std::shared_ptr<TriangleMesh> mesh;          // set for mesh shapes
     std::shared_ptr<QuadricShape> quadric;       // set for quadrics
+    std::shared_ptr<CurveShape> curve;           // set for curves (curves.h)
     std::string type;                            // the directive's type name
     FileLoc loc;
     size_t triangleCount() const { return mesh ? mesh->triangleCount() : 0; }

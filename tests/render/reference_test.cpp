@@ -1,7 +1,7 @@
 // Correctness against pbrt-v3: every scene of ../shared/references/manifest.tsv (surface
-// scenes, and the media=1 scenes rendered with volpath semantics) is rendered at 64 spp
-// (fixed seed) with every guiding backend (none, hemi, vdb) and compared with pbrt-v3's
-// reference.
+// scenes, and the media=1 scenes rendered with volpath semantics), and the feature scenes of
+// ../shared/references/features/manifest.tsv, are rendered at 64 spp (fixed seed) with every
+// guiding backend (none, hemi, vdb) and compared with pbrt-v3's reference.
 // Bounds (issue "path tracer" acceptance): relMSE <= 1.5x pbrt-v3's own 64-spp relMSE;
 // median block deviation <= max(2%, 1.5x pbrt-v3's own 64-spp figure); no NaN/Inf.
 // The feature scenes of ../shared/references/features/manifest.tsv (issue 35: one small scene
@@ -176,6 +176,8 @@ struct FeatureScene {
 const FeatureScene kFeatureScenes[] = {
     {"pbrt-features__disney", {70, 1.0}},
     {"pbrt-features__nurbs", {}},
+    {"pbrt-features__curves", {}},  // flat, cylinder and ribbon curves
+    {"pbrt-features__hair", {}},    // hair on cylinder curves (sigma_a and pigments)
 };
 
 void PrintTo(const FeatureScene& f, std::ostream* os) { *os << f.id; }
