@@ -9,6 +9,7 @@
 #include <cstdlib>
 
 #include "guiding/hemi.h"
+#include "guiding/options.h"
 #include "guiding/vdb.h"
 
 namespace rlpbrt::guiding {
@@ -73,17 +74,24 @@ bool parseUnsigned(const std::string& s, uint64_t maxValue, uint64_t* out) {
     return true;
 }
 
-// The "bad value" message of a backend's parameter; returns false.
+// The "bad value" message of a backend's parameter, with what the options table
+// (guiding/options.h) says it accepts; returns false.
 bool badValue(const char* backend, const std::string& key, const std::string& value,
-              const char* expected, std::string* error) {
+              std::string* error) {
+    const GuideOption* o = findGuideOption(key);
     *error = std::string("guiding backend '") + backend + "': bad value '" + value +
-             "' for parameter '" + key + "' (expected " + expected + ")";
+             "' for parameter '" + key + "' (expected " + (o ? o->expected : "?") + ")";
     return false;
 }
 
-// A strata value, "WxH" or "N" (N x N), with integers in 1..64; false if it is anything else
-// (then kStrataExpected says what was expected).
-constexpr const char* kStrataExpected = "WxH or N with integers in 1..64";
+// The "unknown parameter" message of a backend; returns false.
+bool unknownParam(const char* backend, const std::string& key, std::string* error) {
+    *error = std::string("guiding backend '") + backend + "': unknown parameter '" + key +
+             "' (known: " + knownGuideOptions(backend) + ")";
+    return false;
+}
+
+// A strata value, "WxH" or "N" (N x N), with integers in 1..64; false if it is anything else.
 bool parseStrata(const std::string& value, int* cols, int* rows) {
     const size_t x = value.find_first_of("xX");
     uint64_t w = 0, h = 0;
@@ -105,8 +113,8 @@ bool parseStrata(const std::string& value, int* cols, int* rows) {
 template <class Params>
 int parseSharedParam(const char* backend, const std::string& key, const std::string& value,
                      Params* p, double* maxMiB, std::string* error) {
-    auto bad = [&](const char* expected) {
-        badValue(backend, key, value, expected, error);
+    auto bad = [&]() {
+        badValue(backend, key, value, error);
         return -1;
     };
     double d = 0.0;
@@ -118,37 +126,40 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
             p->alphaVisits = false;
             p->fixedAlpha = d;
         } else {
-            return bad("'visits' or a number in (0, 1]");
+            return bad();
         }
     } else if (key == "strata") {
         if (!parseStrata(value, &p->cols, &p->rows))
-            return bad(kStrataExpected);
+            return bad();
     } else if (key == "points") {
         if (!parseUnsigned(value, uint64_t(1) << 26, &u) || u < 1)
-            return bad("an integer in 1..67108864");
+            return bad();
         p->points = u;
     } else if (key == "normal-angle") {
         if (!parseDouble(value, &d) || !(d > 0.0) || !(d < 180.0))
-            return bad("degrees in (0, 180)");
+            return bad();
         p->normalAngleDeg = d;
     } else if (key == "init") {
         if (!parseDouble(value, &d) || !(d > 0.0) || d > double(FLT_MAX))
-            return bad("a positive number <= 3.4e38");
+            return bad();
         p->init = d;
     } else if (key == "epsilon") {
-        if (!parseDouble(value, &d) || d < 0.0 || d > 1.0) return bad("a number in [0, 1]");
+        if (!parseDouble(value, &d) || d < 0.0 || d > 1.0) return bad();
         p->epsilon = d;
     } else if (key == "cosine") {
-        if (value != "0" && value != "1") return bad("0 or 1");
+        if (value != "0" && value != "1") return bad();
         p->cosine = value == "1";
     } else if (key == "smooth") {
-        if (!parseDouble(value, &d) || d < 0.0 || d > 1e9) return bad("a number in [0, 1e9]");
+        if (!parseDouble(value, &d) || d < 0.0 || d > 1e9) return bad();
         p->smooth = d;
+    } else if (key == "warmup") {
+        if (!parseDouble(value, &d) || d < 0.0 || d > 1e9) return bad();
+        p->warmup = d;
     } else if (key == "max-mb") {
-        if (!parseDouble(value, &d) || !(d > 0.0)) return bad("a positive number");
+        if (!parseDouble(value, &d) || !(d > 0.0)) return bad();
         *maxMiB = d;
-    } else if (key == "mix" || key == "target" || key == "samples" || key == "auto" ||
-               key == "rr" || key == "rr-window" || key == "learn") {
+    } else if (const GuideOption* o = findGuideOption(key);
+               o && std::string(o->owner) == "integrator") {
         // Consumed by the integrator and the render loop.
     } else {
         return 0;
@@ -167,24 +178,15 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         uint64_t u = 0;
         if (key == "knn") {
             if (!parseUnsigned(value, 64, &u) || u < 1)
-                return badValue("hemi", key, value, "an integer in 1..64", error);
+                return badValue("hemi", key, value, error);
             hp->knn = int(u);
-        } else if (key == "warmup") {
-            double d = 0.0;
-            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
-                return badValue("hemi", key, value, "a number in [0, 1e9]", error);
-            hp->warmup = d;
         } else if (key == "lookup") {
             if (value != "patch" && value != "cell" && value != "exact")
-                return badValue("hemi", key, value, "patch, cell or exact", error);
+                return badValue("hemi", key, value, error);
             hp->cellLookup = value != "exact";
             hp->patchLookup = value == "patch";
         } else {
-            *error = "guiding backend 'hemi': unknown parameter '" + key +
-                     "' (known: alpha, strata, points, normal-angle, init, epsilon, knn, "
-                     "cosine, warmup, lookup, smooth, max-mb, mix, target, samples, auto, rr, "
-                     "rr-window, learn)";
-            return false;
+            return unknownParam("hemi", key, error);
         }
     }
     return true;
@@ -201,49 +203,36 @@ bool parseVdbParams(const std::map<std::string, std::string>& params, VdbParams*
         uint64_t u = 0;
         if (key == "voxel") {
             if (!parseUnsigned(value, 4096, &u) || u < 1)
-                return badValue("vdb", key, value,
-                                "a voxel count along the longest axis, 1..4096", error);
+                return badValue("vdb", key, value, error);
             vp->voxelCount = int(u);
         } else if (key == "voxel-size") {
             if (!parseDouble(value, &d) || !(d > 0.0))
-                return badValue("vdb", key, value, "a positive voxel edge in world units", error);
+                return badValue("vdb", key, value, error);
             vp->voxelSize = d;
         } else if (key == "dirs") {
             if (value != "hemi" && value != "sphere")
-                return badValue("vdb", key, value, "hemi or sphere", error);
+                return badValue("vdb", key, value, error);
             vp->sphere = value == "sphere";
         } else if (key == "normals") {
             if (!parseUnsigned(value, 16, &u) || u < 1)
-                return badValue("vdb", key, value, "an integer in 1..16", error);
+                return badValue("vdb", key, value, error);
             vp->normals = int(u);
-        } else if (key == "warmup") {
-            double d = 0.0;
-            if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
-                return badValue("vdb", key, value, "a number in [0, 1e9]", error);
-            vp->warmup = d;
         } else if (key == "volume") {
-            if (value != "0" && value != "1") return badValue("vdb", key, value, "0 or 1", error);
+            if (value != "0" && value != "1") return badValue("vdb", key, value, error);
             vp->volume = value == "1";
         } else if (key == "volume-strata") {
             if (!parseStrata(value, &vp->volumeCols, &vp->volumeRows))
-                return badValue("vdb", key, value, kStrataExpected, error);
+                return badValue("vdb", key, value, error);
         } else if (key == "volume-warmup") {
             if (!parseDouble(value, &d) || d < 0.0 || d > 1e9)
-                return badValue("vdb", key, value, "a number in [0, 1e9]", error);
+                return badValue("vdb", key, value, error);
             vp->volumeWarmup = d;
         } else if (key == "volume-voxel") {
             if (!parseUnsigned(value, 1024, &u) || u < 1)
-                return badValue("vdb", key, value,
-                                "a voxel count along the longest axis of the media, 1..1024",
-                                error);
+                return badValue("vdb", key, value, error);
             vp->volumeVoxels = int(u);
         } else {
-            *error = "guiding backend 'vdb': unknown parameter '" + key +
-                     "' (known: alpha, strata, voxel, voxel-size, points, dirs, normals, "
-                     "normal-angle, init, epsilon, cosine, warmup, smooth, volume, "
-                     "volume-voxel, volume-strata, volume-warmup, max-mb, mix, target, "
-                     "samples, auto, rr, rr-window, learn)";
-            return false;
+            return unknownParam("vdb", key, error);
         }
     }
     if (vp->voxelCount > 0 && vp->voxelSize > 0.0) {

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "guiding/options.h"
 #include "render/media.h"
 #include "render/path_recorder.h"
 #include "render/roulette.h"
@@ -42,6 +43,12 @@ PathIntegrator::PathIntegrator(const Scene& scene, const GuideSettings& guide)
 }
 
 namespace {
+// The message of a bad value for one of the integrator's guide options; returns false.
+bool badOption(const std::string& key, const std::string& value, std::string* error) {
+    const guiding::GuideOption* o = guiding::findGuideOption(key);
+    *error = key + " must be " + (o ? o->expected : "?") + ", got \"" + value + "\"";
+    return false;
+}
 // A whole-string number (strtof syntax); false if the text is anything else.
 bool parseFloat(const std::string& text, float* out) {
     char* end = nullptr;
@@ -69,17 +76,14 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     } else if (it != config.params.end()) {
         float mix = 0.f;
         if (!parseFloat(it->second, &mix) || !(mix >= 0.f && mix <= 1.f)) {
-            *error = "mix must be a number in [0, 1] or \"learn\", got \"" + it->second + "\"";
-            return false;
+            return badOption("mix", it->second, error);
         }
         settings->mix = mix;
     }
     auto target = config.params.find("target");
     if (target != config.params.end()) {
         if (target->second != "sum" && target->second != "sample" && target->second != "path") {
-            *error = "target must be \"sum\", \"sample\" or \"path\", got \"" +
-                     target->second + "\"";
-            return false;
+            return badOption("target", target->second, error);
         }
         settings->sampledTarget = target->second != "sum";
         settings->pathTarget = target->second == "path";
@@ -87,17 +91,14 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     auto samples = config.params.find("samples");
     if (samples != config.params.end()) {
         if (samples->second != "sequence" && samples->second != "independent") {
-            *error = "samples must be \"sequence\" or \"independent\", got \"" +
-                     samples->second + "\"";
-            return false;
+            return badOption("samples", samples->second, error);
         }
         settings->independentPasses = samples->second == "independent";
     }
     auto rr = config.params.find("rr");
     if (rr != config.params.end()) {
         if (rr->second != "adjoint" && rr->second != "pbrt") {
-            *error = "rr must be \"adjoint\" or \"pbrt\", got \"" + rr->second + "\"";
-            return false;
+            return badOption("rr", rr->second, error);
         }
         settings->adjointRoulette = rr->second == "adjoint";
     }
@@ -105,23 +106,18 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     if (window != config.params.end()) {
         float w = 0.f;
         if (!parseFloat(window->second, &w) || !(w > 0.f && w <= 1.f)) {
-            *error = "rr-window must be a number in (0, 1], got \"" + window->second + "\"";
-            return false;
+            return badOption("rr-window", window->second, error);
         }
         settings->rouletteWindow = w;
     }
     auto learn = config.params.find("learn");
     if (learn != config.params.end() && learn->second != "all" &&
         !parseSampleCount(learn->second, &settings->learnSpp)) {
-        *error = "learn must be \"all\" or a sample count in [0, 16777216], got \"" +
-                 learn->second + "\"";
-        return false;
+        return badOption("learn", learn->second, error);
     }
     auto autoSpp = config.params.find("auto");
     if (autoSpp != config.params.end() && !parseSampleCount(autoSpp->second, &settings->autoSpp)) {
-        *error = "auto must be a sample count in [0, 16777216] (0 = always guide), got \"" +
-                 autoSpp->second + "\"";
-        return false;
+        return badOption("auto", autoSpp->second, error);
     }
     if (config.backend == "none") return true;
     guiding::SceneInfo info;

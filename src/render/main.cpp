@@ -11,6 +11,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "guiding/options.h"
 #include "parser/diagnostics.h"
 #include "render/checkpoint.h"
 #include "render/image_io.h"
@@ -87,13 +88,15 @@ int main(int argc, char** argv) {
     app.add_option("--guide", guide, "guiding backend: none, hemi (the default) or vdb")
         ->check(CLI::IsMember({"none", "hemi", "vdb"}));
     app.add_option("--guide-param", guideParams,
-                   "guiding parameter key=value (repeatable): mix (0..1 or learn), alpha, "
-                   "strata (WxH), points, normal-angle, init, epsilon, cosine, smooth, max-mb, "
-                   "target (path, sample or sum), rr (adjoint or pbrt), rr-window, samples, auto (N "
-                   "spp: a guided-or-plain trial; default off), learn (N spp or all); hemi: knn, warmup, lookup "
-                   "(patch, cell or exact); vdb: "
-                   "voxel, voxel-size, dirs, normals, warmup, volume, volume-voxel "
-                   "(README.md)");
+                   "guiding parameter key=value (repeatable; --guide-options lists every key "
+                   "with its default, docs/GUIDING.md explains them)");
+    app.add_flag_callback(
+        "--guide-options",
+        [] {
+            std::fputs(guiding::guideOptionsHelp().c_str(), stdout);
+            throw CLI::Success();
+        },
+        "list the --guide-param keys with their defaults and exit");
     app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering");
     app.add_option("--guide-load", guideLoad,
                    "start from a guiding field saved for this scene with the same backend");
