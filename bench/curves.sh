@@ -14,7 +14,7 @@
 # Writes OUTDIR/<scene>__<config>.{csv,json,exr}; bench/curves_report.py summarises them.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-shared=${SHARED:-$here/../shared}
+shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
 bin=${RLPBRT:-$here/build/rlpbrt}
 secs=${1:?usage: $0 SECONDS OUTDIR [scene-id ...]}
 out=${2:?usage: $0 SECONDS OUTDIR [scene-id ...]}
