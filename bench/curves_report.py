@@ -14,7 +14,8 @@ longer paths that carry light are not charged as the guide's cost; docs/BENCHMAR
 session 18), the zero-contribution fraction, mean path length and guide memory.
 With --plots: OUTDIR/curves.png (relMSE against seconds, log-log, one panel per scene) and
 OUTDIR/images.png (the final images side by side with the reference, all at equal time;
-needs build/rlpbrt-imgtool to convert EXR to PNG).
+needs build/rlpbrt-imgtool to convert EXR to PNG; the images are read from $IMAGES, default
+bench/out/<OUTDIR's name>, where bench/curves.sh writes them).
 """
 import csv
 import glob
@@ -143,7 +144,11 @@ def main():
     # Final images at equal time, next to the reference.
     here = os.path.dirname(os.path.abspath(__file__))
     tool = os.environ.get("IMGTOOL", os.path.join(here, "..", "build", "rlpbrt-imgtool"))
-    shared = os.environ.get("SHARED", os.path.join(here, "..", "..", "shared"))
+    shared = os.environ.get("SHARED", os.environ.get("RLPBRT_SHARED",
+                                                     os.path.join(here, "..", "..", "shared")))
+    images = os.environ.get("IMAGES", os.path.join(here, "out",
+                                                   os.path.basename(os.path.normpath(out))))
+    os.makedirs(images, exist_ok=True)
     configs = ["reference"] + sorted({c for s in runs.values() for c in s},
                                      key=lambda k: (k != "none", k))
     fig, axes = plt.subplots(len(scenes), len(configs),
@@ -153,8 +158,8 @@ def main():
             ax = axes[i][j]
             ax.axis("off")
             src = (os.path.join(shared, "references", scene + ".exr") if config == "reference"
-                   else os.path.join(out, "{}__{}.exr".format(scene, config)))
-            png = os.path.join(out, "{}__{}.png".format(scene, config))
+                   else os.path.join(images, "{}__{}.exr".format(scene, config)))
+            png = os.path.join(images, "{}__{}.png".format(scene, config))
             if not os.path.exists(src):
                 continue
             subprocess.run([tool, "convert", src, png], check=False,
