@@ -1,5 +1,5 @@
-// Runs the rlpbrt command line (RLPBRT_BINARY) in a shell and captures its exit status and
-// its output (stdout and stderr together).
+// Runs a command line in a shell (runCommand), or rlpbrt's (runCli: RLPBRT_BINARY), and
+// captures its exit status and its output (stdout and stderr together).
 #pragma once
 
 #include <sys/wait.h>
@@ -14,9 +14,9 @@ struct CliRun {
     std::string output;
 };
 
-inline CliRun runCli(const std::string& args) {
+inline CliRun runCommand(const std::string& command) {
     CliRun r;
-    std::string cmd = std::string(RLPBRT_BINARY) + " " + args + " 2>&1";
+    const std::string cmd = command + " 2>&1";
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return r;
     char buf[4096];
@@ -25,6 +25,10 @@ inline CliRun runCli(const std::string& args) {
     int st = pclose(p);
     r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     return r;
+}
+
+inline CliRun runCli(const std::string& args) {
+    return runCommand(std::string(RLPBRT_BINARY) + " " + args);
 }
 
 }  // namespace rlpbrt::test
