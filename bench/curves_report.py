@@ -10,7 +10,7 @@ relative to none) and per path vertex (the same divided by the mean path lengths
 what a vertex costs, apart from paths that grow or shrink), the overhead at plain path
 length (the overhead per sample divided by max(1, path length / none's): per vertex where
 the configuration's paths are longer than none's, per sample where they are not, so that
-longer paths that carry light are not charged as the guide's cost; docs/BENCHMARKS.md,
+longer paths that carry light are not charged as the guide's cost; docs/BENCHMARKS_HISTORY.md,
 session 18), the zero-contribution fraction, mean path length and guide memory.
 With --plots: OUTDIR/curves.png (relMSE against seconds, log-log, one panel per scene) and
 OUTDIR/images.png (the final images side by side with the reference, all at equal time;
@@ -65,9 +65,8 @@ def break_even(curve, base):
     return result
 
 
-def main():
-    out = sys.argv[1]
-    plots = "--plots" in sys.argv
+def load_runs(out):
+    """{scene id: {config: (curve, stats)}} of a bench/curves.sh run's OUTDIR."""
     runs = {}
     for path in sorted(glob.glob(os.path.join(out, "*__*.csv"))):
         stem = os.path.basename(path)[:-4]
@@ -77,6 +76,13 @@ def main():
             with open(path[:-4] + ".json") as f:
                 stats = json.load(f)
         runs.setdefault(scene, {})[config] = (read_curve(path), stats)
+    return runs
+
+
+def main():
+    out = sys.argv[1]
+    plots = "--plots" in sys.argv
+    runs = load_runs(out)
     print("| scene | config | spp | relMSE at equal time | ratio to none | break-even s "
           "| overhead/sample | overhead/vertex | overhead at plain path length "
           "| zero-contribution | mean path length | guide MiB |")
