@@ -1,11 +1,13 @@
 // The command line's own options: --version names the version and the commit (or "unknown"
-// outside a git checkout), and --help lists the options in groups.
+// outside a git checkout), and --help lists the options in groups. The demo scene
+// (scripts/demo.sh) builds, and its reference has the film's size.
 #include <regex>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "cli_run.h"
+#include "render/image_io.h"
 
 namespace {
 
@@ -31,6 +33,20 @@ TEST(Cli, HelpGroupsTheOptions) {
         ASSERT_NE(next, std::string::npos) << heading << " missing or out of order:\n" << r.output;
         at = next;
     }
+}
+
+TEST(Cli, DemoSceneAndItsReferenceAgree) {
+    const std::string dir = std::string(RLPBRT_SOURCE_DIR) + "/scenes/demo/";
+    auto r = runCli("--parse-only " + dir + "door.pbrt");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("lights: 2 (2 area lights"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("film 256x192"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("ignored features: 0"), std::string::npos) << r.output;
+    rlpbrt::Image ref;
+    std::string err;
+    ASSERT_TRUE(rlpbrt::readImage(dir + "door-ref.exr", &ref, &err)) << err;
+    EXPECT_EQ(ref.width, 256);
+    EXPECT_EQ(ref.height, 192);
 }
 
 }  // namespace
