@@ -33,6 +33,17 @@ TEST(Cli, HelpGroupsTheOptions) {
         ASSERT_NE(next, std::string::npos) << heading << " missing or out of order:\n" << r.output;
         at = next;
     }
+    // Every option has a group: the ungrouped "Options:" list holds only --help and --version.
+    const size_t options = r.output.find("\nOptions:\n"), render = r.output.find("\nRender:\n");
+    ASSERT_NE(options, std::string::npos) << r.output;
+    std::string ungrouped = r.output.substr(options, render - options);
+    for (const char* known : {"--help", "--version"}) {
+        const size_t k = ungrouped.find(known);
+        ASSERT_NE(k, std::string::npos) << ungrouped;
+        ungrouped.erase(k, 2);
+    }
+    EXPECT_EQ(ungrouped.find("--"), std::string::npos) << "an option without a group:\n"
+                                                       << ungrouped;
 }
 
 TEST(Cli, DemoSceneAndItsReferenceAgree) {
