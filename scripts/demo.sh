@@ -29,6 +29,10 @@ render() {
 echo "demo: rendering $scene for $secs s plain, then $secs s guided ..."
 read -r spp_plain rel_plain < <(render plain --guide none "$@")
 read -r spp_guided rel_guided < <(render guided --guide hemi "$@")
+if [ -z "${rel_plain:-}" ] || [ -z "${rel_guided:-}" ]; then
+    echo "demo: a render or its comparison failed (messages above)" >&2
+    exit 1
+fi
 "$tool" convert "$out/demo-guided.exr" "$out/demo.png"
 ratio=$(awk -v a="$rel_plain" -v b="$rel_guided" 'BEGIN { printf "%.1f", a / b }')
 fmt() { awk -v v="$1" 'BEGIN { printf "%.4f", v }'; }
