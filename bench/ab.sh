@@ -15,7 +15,7 @@
 # included (a one-thread render has none).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-shared=${SHARED:-$here/../shared}
+shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
 usage="usage: $0 BIN_A BIN_B SCENE [PAIRS] [SPP] -- [options...]"
 a=${1:?$usage}
 b=${2:?$usage}

@@ -11,15 +11,18 @@
 # k mod nproc (a VM's cores can run at different speeds: run twice with the order reversed
 # and compare both). Configurations: $CONFIGS (space-separated NAME=ARGS entries, ARGS with
 # commas for spaces), default none, hemi, vdb and one variation of each main parameter.
-# Writes OUTDIR/<scene>__<config>.{csv,json,exr}; bench/curves_report.py summarises them.
+# Writes OUTDIR/<scene>__<config>.{csv,json,log} and the images, <scene>__<config>.exr, to
+# $IMAGES (default bench/out/<OUTDIR's name>, ignored by git: images stay out of the tracked
+# tree); bench/curves_report.py summarises them.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-shared=${SHARED:-$here/../shared}
+shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
 bin=${RLPBRT:-$here/build/rlpbrt}
 secs=${1:?usage: $0 SECONDS OUTDIR [scene-id ...]}
 out=${2:?usage: $0 SECONDS OUTDIR [scene-id ...]}
 shift 2
-mkdir -p "$out"
+images=${IMAGES:-$here/bench/out/$(basename "$out")}
+mkdir -p "$out" "$images"
 want=" $* "
 # The backends and their main parameters: strata, points / voxel size, mix.
 default="none=--guide,none hemi=--guide,hemi vdb=--guide,vdb"
@@ -39,6 +42,7 @@ threads=1
     echo "configs: $configs"
     echo "sequential: $sequential (threads per render: $threads, 0 = all); pinned: ${PIN:-0}"
     echo "commit: $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+    echo "images: $images"
 } > "$out/run.txt"
 
 tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media; do
@@ -54,7 +58,7 @@ tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene 
         k=$((k + 1))
         "${pin[@]}" "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads "$threads" --quiet ${args//,/ } \
             --ref "$shared/references/$id.exr" --curve "$out/${id}__$name.csv" \
-            --stats "$out/${id}__$name.json" -o "$out/${id}__$name.exr" \
+            --stats "$out/${id}__$name.json" -o "$images/${id}__$name.exr" \
             > /dev/null 2> "$out/${id}__$name.log" &
         if [ "$sequential" = 1 ]; then
             wait "$!" || echo "warning: $id $name failed (see $out/${id}__$name.log)" >&2

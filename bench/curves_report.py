@@ -10,11 +10,12 @@ relative to none) and per path vertex (the same divided by the mean path lengths
 what a vertex costs, apart from paths that grow or shrink), the overhead at plain path
 length (the overhead per sample divided by max(1, path length / none's): per vertex where
 the configuration's paths are longer than none's, per sample where they are not, so that
-longer paths that carry light are not charged as the guide's cost; docs/BENCHMARKS.md,
+longer paths that carry light are not charged as the guide's cost; docs/BENCHMARKS_HISTORY.md,
 session 18), the zero-contribution fraction, mean path length and guide memory.
 With --plots: OUTDIR/curves.png (relMSE against seconds, log-log, one panel per scene) and
 OUTDIR/images.png (the final images side by side with the reference, all at equal time;
-needs build/rlpbrt-imgtool to convert EXR to PNG).
+needs build/rlpbrt-imgtool to convert EXR to PNG; the images are read from $IMAGES, default
+bench/out/<OUTDIR's name>, where bench/curves.sh writes them).
 """
 import csv
 import glob
@@ -64,9 +65,8 @@ def break_even(curve, base):
     return result
 
 
-def main():
-    out = sys.argv[1]
-    plots = "--plots" in sys.argv
+def load_runs(out):
+    """{scene id: {config: (curve, stats)}} of a bench/curves.sh run's OUTDIR."""
     runs = {}
     for path in sorted(glob.glob(os.path.join(out, "*__*.csv"))):
         stem = os.path.basename(path)[:-4]
@@ -76,6 +76,13 @@ def main():
             with open(path[:-4] + ".json") as f:
                 stats = json.load(f)
         runs.setdefault(scene, {})[config] = (read_curve(path), stats)
+    return runs
+
+
+def main():
+    out = sys.argv[1]
+    plots = "--plots" in sys.argv
+    runs = load_runs(out)
     print("| scene | config | spp | relMSE at equal time | ratio to none | break-even s "
           "| overhead/sample | overhead/vertex | overhead at plain path length "
           "| zero-contribution | mean path length | guide MiB |")
@@ -143,7 +150,11 @@ def main():
     # Final images at equal time, next to the reference.
     here = os.path.dirname(os.path.abspath(__file__))
     tool = os.environ.get("IMGTOOL", os.path.join(here, "..", "build", "rlpbrt-imgtool"))
-    shared = os.environ.get("SHARED", os.path.join(here, "..", "..", "shared"))
+    shared = os.environ.get("SHARED", os.environ.get("RLPBRT_SHARED",
+                                                     os.path.join(here, "..", "..", "shared")))
+    images = os.environ.get("IMAGES", os.path.join(here, "out",
+                                                   os.path.basename(os.path.normpath(out))))
+    os.makedirs(images, exist_ok=True)
     configs = ["reference"] + sorted({c for s in runs.values() for c in s},
                                      key=lambda k: (k != "none", k))
     fig, axes = plt.subplots(len(scenes), len(configs),
@@ -153,8 +164,8 @@ def main():
             ax = axes[i][j]
             ax.axis("off")
             src = (os.path.join(shared, "references", scene + ".exr") if config == "reference"
-                   else os.path.join(out, "{}__{}.exr".format(scene, config)))
-            png = os.path.join(out, "{}__{}.png".format(scene, config))
+                   else os.path.join(images, "{}__{}.exr".format(scene, config)))
+            png = os.path.join(images, "{}__{}.png".format(scene, config))
             if not os.path.exists(src):
                 continue
             subprocess.run([tool, "convert", src, png], check=False,

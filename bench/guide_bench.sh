@@ -7,7 +7,7 @@
 # zero-contribution fraction, mean path length and guide memory, as a markdown table.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-shared=${SHARED:-$here/../shared}
+shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
 bin=${RLPBRT:-$here/build/rlpbrt}
 tool=${IMGTOOL:-$here/build/rlpbrt-imgtool}
 secs=${1:?usage: $0 SECONDS [scene-id ...]}; shift

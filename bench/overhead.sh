@@ -9,7 +9,7 @@
 # scene of ../shared/references/manifest.tsv.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-shared=${SHARED:-$here/../shared}
+shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
 bin=${1:?usage: $0 BIN [PAIRS] [SPP] [scene-id ...]}
 shift
 pairs=${1:-4}

@@ -8,7 +8,7 @@
 # Prints a markdown table; runs each measurement REPEAT times (default 3) and keeps the median.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-shared=${SHARED:-$here/../shared}
+shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
 bin=${RLPBRT:-$here/build/rlpbrt}
 repeat=${REPEAT:-3}
 tmp=$(mktemp -d)

@@ -13,6 +13,7 @@
 
 #include "guiding/options.h"
 #include "parser/diagnostics.h"
+#include "rlpbrt_commit.h"  // generated at build time: RLPBRT_COMMIT
 #include "render/checkpoint.h"
 #include "render/image_io.h"
 #include "render/metrics.h"
@@ -70,46 +71,65 @@ int main(int argc, char** argv) {
     int spp = 0, nThreads = 0;
     double timeBudget = 0.0, checkpointEvery = -1.0;
     uint64_t seed = 0;
+    // Option groups of --help (CLI11 lists each group under its name).
+    const std::string gRender = "Render", gGuiding = "Guiding", gOutput = "Output",
+                      gDiagnostics = "Diagnostics";
+    app.set_version_flag("--version", std::string("rlpbrt ") + RLPBRT_VERSION + " (commit " +
+                                          RLPBRT_COMMIT + ")");
     app.add_option("scene", scenePath, "pbrt-v3 scene file")->required();
-    app.add_flag("--parse-only", parseOnly, "parse and build the scene, print a summary, exit");
-    app.add_option("--outfile,-o", outFile, "output image (.exr, .png, .pfm, .hdr); default: the "
-                                            "Film's filename");
     app.add_option("--spp", spp, "samples per pixel (overrides the Sampler's pixelsamples)")
-        ->check(CLI::Range(1, 1 << 24));
+        ->check(CLI::Range(1, 1 << 24))
+        ->group(gRender);
     app.add_option("--time", timeBudget, "render whole passes until SECONDS are spent")
-        ->check(CLI::Range(0.0, 1e9));
+        ->check(CLI::Range(0.0, 1e9))
+        ->group(gRender);
     app.add_option("--nthreads", nThreads, "threads (default: all cores)")
-        ->check(CLI::Range(0, 4096));
-    app.add_option("--seed", seed, "random seed");
-    app.add_flag("--quiet,-q", quiet, "no progress or summary output");
-    app.add_flag("--strict", strict, "treat every unsupported feature and every substitute "
-                                     "(pbrt-v3's tolerance of bad input) as an error");
+        ->check(CLI::Range(0, 4096))
+        ->group(gRender);
+    app.add_option("--seed", seed, "random seed")->group(gRender);
     std::vector<std::string> guideParams;
     app.add_option("--guide", guide, "guiding backend: none, hemi (the default) or vdb")
-        ->check(CLI::IsMember({"none", "hemi", "vdb"}));
+        ->check(CLI::IsMember({"none", "hemi", "vdb"}))
+        ->group(gGuiding);
     app.add_option("--guide-param", guideParams,
                    "guiding parameter key=value (repeatable; --guide-options lists every key "
-                   "with its default, docs/GUIDING.md explains them)");
+                   "with its default, docs/GUIDING.md explains them)")
+        ->group(gGuiding);
     app.add_flag_callback(
-        "--guide-options",
-        [] {
-            std::fputs(guiding::guideOptionsHelp().c_str(), stdout);
-            throw CLI::Success();
-        },
-        "list the --guide-param keys with their defaults and exit");
-    app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering");
+           "--guide-options",
+           [] {
+               std::fputs(guiding::guideOptionsHelp().c_str(), stdout);
+               throw CLI::Success();
+           },
+           "list the --guide-param keys with their defaults and exit")
+        ->group(gGuiding);
+    app.add_option("--guide-save", guideSave, "save the learned guiding field after rendering")
+        ->group(gGuiding);
     app.add_option("--guide-load", guideLoad,
-                   "start from a guiding field saved for this scene with the same backend");
-    app.add_option("--stats", statsFile, "write run statistics as JSON");
-    auto* refOpt = app.add_option("--ref", refFile, "reference image for --curve (same size as "
-                                                    "the film's output)");
-    app.add_option("--curve", curveFile, "write seconds,spp,relmse against --ref after each "
-                                         "pass to this CSV file")
-        ->needs(refOpt);
+                   "start from a guiding field saved for this scene with the same backend")
+        ->group(gGuiding);
+    app.add_option("--outfile,-o", outFile, "output image (.exr, .png, .pfm, .hdr); default: the "
+                                            "Film's filename")
+        ->group(gOutput);
+    app.add_flag("--quiet,-q", quiet, "no progress or summary output")->group(gOutput);
     app.add_option("--checkpoint", checkpointEvery,
                    "write the image so far (atomically, real spp in its metadata) after each "
                    "pass once SECONDS have passed since the last checkpoint")
-        ->check(CLI::Range(0.0, 1e9));
+        ->check(CLI::Range(0.0, 1e9))
+        ->group(gOutput);
+    app.add_flag("--parse-only", parseOnly, "parse and build the scene, print a summary, exit")
+        ->group(gDiagnostics);
+    app.add_option("--stats", statsFile, "write run statistics as JSON")->group(gDiagnostics);
+    auto* refOpt = app.add_option("--ref", refFile, "reference image for --curve (same size as "
+                                                    "the film's output)")
+                       ->group(gDiagnostics);
+    app.add_option("--curve", curveFile, "write seconds,spp,relmse against --ref after each "
+                                         "pass to this CSV file")
+        ->needs(refOpt)
+        ->group(gDiagnostics);
+    app.add_flag("--strict", strict, "treat every unsupported feature and every substitute "
+                                     "(pbrt-v3's tolerance of bad input) as an error")
+        ->group(gDiagnostics);
     CLI11_PARSE(app, argc, argv);
     // From here on SIGINT/SIGTERM finish the current pass and write the image so far.
     std::signal(SIGINT, onSignal);
@@ -235,6 +255,7 @@ int main(int argc, char** argv) {
     auto metadata = [&](int spp, double renderSeconds) -> ImageMetadata {
         return {
             {"rlpbrt:version", RLPBRT_VERSION},
+            {"rlpbrt:commit", RLPBRT_COMMIT},
             {"rlpbrt:spp", std::to_string(spp)},
             {"rlpbrt:seconds", std::to_string(renderSeconds)},
             {"rlpbrt:seed", std::to_string(seed)},

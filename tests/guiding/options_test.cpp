@@ -1,5 +1,8 @@
-// The table of guide options (guiding/options.h) against the parsers that read it.
+// The table of guide options (guiding/options.h) against the parsers that read it and the
+// docs that describe it.
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -66,6 +69,24 @@ TEST(GuideOptions, BadValueMessagesComeFromTheTable) {
     std::string error;
     EXPECT_EQ(createGuidingField(config, scene, &error), nullptr);
     EXPECT_NE(error.find(findGuideOption("knn")->expected), std::string::npos) << error;
+}
+
+// docs/GUIDING.md's table names every key with its default.
+TEST(GuideOptions, DocsListEveryKeyWithItsDefault) {
+    std::ifstream f(std::string(RLPBRT_SOURCE_DIR) + "/docs/GUIDING.md");
+    ASSERT_TRUE(f.good()) << "docs/GUIDING.md is missing";
+    std::stringstream ss;
+    ss << f.rdbuf();
+    const std::string docs = ss.str();
+    for (const GuideOption& o : guideOptions()) {
+        const std::string row = "| `" + std::string(o.key) + "` |";
+        const size_t at = docs.find(row);
+        ASSERT_NE(at, std::string::npos) << "no table row for " << o.key;
+        const std::string line = docs.substr(at, docs.find('\n', at) - at);
+        if (literalDefault(o))
+            EXPECT_NE(line.find(std::string("| ") + o.defaultValue), std::string::npos)
+                << o.key << ": " << line;
+    }
 }
 
 }  // namespace

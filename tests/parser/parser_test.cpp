@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "recording_sink.h"
+#include "shared_data.h"
 
 namespace rlpbrt {
 namespace {
@@ -524,8 +525,8 @@ TEST(Parser, SpdFileIsRelativeToTheFileThatNamesIt) {
 }
 
 TEST(Parser, SharedSceneCloudParsesWithIncludeContinuation) {
-    std::string path = "/work/shared/scenes/cloud/cloud.pbrt";
-    if (!fs::exists(path)) GTEST_SKIP() << path << " not available";
+    RLPBRT_REQUIRE_SHARED();
+    std::string path = rlpbrt::test::sharedDir() + "/scenes/cloud/cloud.pbrt";
     Parsed r;
     r.diag.setStream(nullptr);
     r.sink.maxValues = 16;
@@ -536,7 +537,8 @@ TEST(Parser, SharedSceneCloudParsesWithIncludeContinuation) {
     for (const auto& line : r.sink.lines)
         if (line.rfind("MakeNamedMedium \"smoke\"", 0) == 0) {
             ++media;
-            EXPECT_NE(line.find("@/work/shared/scenes/cloud/geometry/density_render.70.pbrt:1:1"),
+            EXPECT_NE(line.find("@" + rlpbrt::test::sharedDir() +
+                                "/scenes/cloud/geometry/density_render.70.pbrt:1:1"),
                       std::string::npos);
         }
     EXPECT_EQ(media, 1);
@@ -555,8 +557,8 @@ TEST(Parser, SharedSceneCloudParsesWithIncludeContinuation) {
 }
 
 TEST(Parser, AllSharedScenesParseWithoutErrors) {
-    std::string root = "/work/shared/scenes";
-    if (!fs::exists(root)) GTEST_SKIP() << root << " not available";
+    RLPBRT_REQUIRE_SHARED();
+    std::string root = rlpbrt::test::sharedDir() + "/scenes";
     int files = 0;
     for (const auto& scene : fs::directory_iterator(root)) {
         if (!scene.is_directory()) continue;

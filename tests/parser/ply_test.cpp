@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "shared_data.h"
+
 namespace rlpbrt {
 namespace {
 
@@ -333,12 +335,8 @@ TEST(Ply, EveryTruncationFails) {
 }
 
 TEST(Ply, AllScenePlyFilesRead) {
-    fs::path dir = fs::path(RLPBRT_SOURCE_DIR) / ".." / "shared" / "scenes";
-    if (!fs::is_directory(dir)) {
-        const char* ci = std::getenv("CI");
-        if (ci && std::string(ci) == "true") FAIL() << "missing scene directory " << dir;
-        GTEST_SKIP() << "no scene directory " << dir;
-    }
+    RLPBRT_REQUIRE_SHARED();
+    fs::path dir = fs::path(rlpbrt::test::sharedDir()) / "scenes";
     int files = 0;
     for (const auto& entry : fs::recursive_directory_iterator(dir)) {
         if (!entry.is_regular_file() || entry.path().extension() != ".ply") continue;

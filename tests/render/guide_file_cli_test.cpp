@@ -12,25 +12,12 @@
 
 #include <gtest/gtest.h>
 
+#include "cli_run.h"
+
 namespace {
 
-struct CliRun {
-    int status = -1;
-    std::string output;
-};
-
-CliRun run(const std::string& args) {
-    CliRun r;
-    std::string cmd = std::string(RLPBRT_BINARY) + " " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.output.append(buf, n);
-    int st = pclose(p);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return r;
-}
+using rlpbrt::test::CliRun;
+CliRun run(const std::string& args) { return rlpbrt::test::runCli(args); }
 
 // A 24x24 box room lit by a quad; `wide` moves a wall so the bounds change.
 std::string writeScene(const std::string& path, bool wide) {

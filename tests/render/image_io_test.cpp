@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <OpenImageIO/imageio.h>
 
+#include "shared_data.h"
+
 namespace rlpbrt {
 namespace {
 
@@ -281,9 +283,8 @@ TEST_F(ImageIoTest, MissingFileIsAnError) {
 }
 
 TEST(ImageIoScenes, ReadsSceneTextures) {
-    const std::string png =
-        std::string(RLPBRT_SOURCE_DIR) + "/../shared/scenes/breakfast/textures/goldbuddha.png";
-    if (!fs::exists(png)) GTEST_SKIP() << "shared scenes not found";
+    RLPBRT_REQUIRE_SHARED();
+    const std::string png = rlpbrt::test::sharedDir() + "/scenes/breakfast/textures/goldbuddha.png";
     Image img;
     ImageFileInfo info;
     std::string err;

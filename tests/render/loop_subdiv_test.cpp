@@ -11,6 +11,8 @@
 #include <sstream>
 #include <utility>
 
+#include "shared_data.h"
+
 namespace rlpbrt {
 namespace {
 
@@ -268,14 +270,11 @@ std::vector<T> readArray(const std::string& text, const std::string& name) {
 }
 
 TEST(LoopSubdiv, KillerooSceneMesh) {
-    std::string path = std::string(RLPBRT_SOURCE_DIR) +
-                       "/../shared/scenes/killeroo-simple/geometry/killeroo.pbrt";
+    RLPBRT_REQUIRE_SHARED();
+    std::string path =
+        rlpbrt::test::sharedDir() + "/scenes/killeroo-simple/geometry/killeroo.pbrt";
     std::ifstream f(path);
-    if (!f) {
-        const char* ci = std::getenv("CI");
-        if (ci && std::string(ci) == "true") FAIL() << "missing " << path;
-        GTEST_SKIP() << "no " << path;
-    }
+    ASSERT_TRUE(f) << "cannot read " << path;
     std::stringstream ss;
     ss << f.rdbuf();
     std::string text = ss.str();

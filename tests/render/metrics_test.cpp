@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "render/image_io.h"
+#include "shared_data.h"
 
 namespace rlpbrt {
 namespace {
@@ -188,9 +189,10 @@ TEST(Metrics, HasNonFinite) {
 }
 
 TEST(Metrics, ManifestReferencesAgainstThemselves) {
-    const std::string dir = std::string(RLPBRT_SOURCE_DIR) + "/../shared/references/";
+    RLPBRT_REQUIRE_SHARED();
+    const std::string dir = rlpbrt::test::sharedDir() + "/references/";
     std::ifstream manifest(dir + "manifest.tsv");
-    if (!manifest) GTEST_SKIP() << "no reference manifest at " << dir;
+    ASSERT_TRUE(manifest) << "cannot read " << dir << "manifest.tsv";
     std::string line;
     std::getline(manifest, line);  // header
     int checked = 0;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "parser/spd.h"
+#include "shared_data.h"
 
 namespace rlpbrt {
 namespace {
@@ -60,7 +61,7 @@ void expectNear(const Spectrum& a, const Vec3& b, double relTol) {
 }
 
 std::string scenesDir() {
-    return std::string(RLPBRT_SOURCE_DIR) + "/../shared/scenes/";
+    return rlpbrt::test::sharedDir() + "/scenes/";
 }
 
 TEST(Spectrum, CieTablesIntegrateToKnownValues) {
@@ -197,9 +198,8 @@ struct MetalCase {
 };
 
 TEST(Spectrum, MetalSpdFiles) {
+    RLPBRT_REQUIRE_SHARED();
     const std::string dir = scenesDir();
-    if (!std::filesystem::exists(dir + "breakfast/spds/Ag.eta.spd"))
-        GTEST_SKIP() << "shared scenes not found at " << dir;
     const MetalCase cases[] = {
         {"breakfast/spds/Ag.eta.spd", Vec3(0.155f, 0.117f, 0.138f), 0.01f},
         {"breakfast/spds/Ag.k.spd", Vec3(4.83f, 3.12f, 2.15f), 0.05f},

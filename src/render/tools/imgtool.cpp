@@ -1,45 +1,50 @@
-// rlpbrt-imgtool: image utilities for tests and benchmarks.
+// rlpbrt-imgtool: image utilities for tests, benchmarks and the demo.
 //   rlpbrt-imgtool compare TEST REF   prints relmse_trim, block_bias and nonfinite as JSON
 //   rlpbrt-imgtool convert IN OUT     converts between formats (tone: PNG is sRGB, clamped)
+//   rlpbrt-imgtool side-by-side LEFT RIGHT OUT [CAPTION_LEFT CAPTION_RIGHT]
+//                                     the two images (same size) next to each other, each
+//                                     with its caption below ('|' or a newline starts a line)
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
 #include "render/image_io.h"
 #include "render/metrics.h"
+#include "render/tools/caption.h"
 
 using namespace rlpbrt;
 
-int main(int argc, char** argv) {
-    if (argc != 4) {
-        std::fprintf(stderr, "usage: rlpbrt-imgtool compare TEST REF | convert IN OUT\n");
-        return 2;
-    }
-    std::string cmd = argv[1], err;
+namespace {
+
+const char* kUsage =
+    "usage: rlpbrt-imgtool compare TEST REF | convert IN OUT |\n"
+    "       side-by-side LEFT RIGHT OUT [CAPTION_LEFT CAPTION_RIGHT]\n";
+
+bool read(const char* path, Image* img) {
+    std::string err;
+    if (readImage(path, img, &err)) return true;
+    std::fprintf(stderr, "%s: error: %s\n", path, err.c_str());
+    return false;
+}
+
+bool write(const char* path, const Image& img) {
+    std::string err;
+    if (writeImage(path, img, {}, &err)) return true;
+    std::fprintf(stderr, "%s: error: %s\n", path, err.c_str());
+    return false;
+}
+
+bool sameSize(const Image& a, const Image& b) {
+    if (a.width == b.width && a.height == b.height) return true;
+    std::fprintf(stderr, "error: image sizes differ: %dx%d vs %dx%d\n", a.width, a.height,
+                 b.width, b.height);
+    return false;
+}
+
+int compare(const char* testPath, const char* refPath) {
     Image a, b;
-    if (!readImage(argv[2], &a, &err)) {
-        std::fprintf(stderr, "%s: error: %s\n", argv[2], err.c_str());
-        return 1;
-    }
-    if (cmd == "convert") {
-        if (!writeImage(argv[3], a, {}, &err)) {
-            std::fprintf(stderr, "%s: error: %s\n", argv[3], err.c_str());
-            return 1;
-        }
-        return 0;
-    }
-    if (cmd != "compare") {
-        std::fprintf(stderr, "unknown command \"%s\"\n", cmd.c_str());
-        return 2;
-    }
-    if (!readImage(argv[3], &b, &err)) {
-        std::fprintf(stderr, "%s: error: %s\n", argv[3], err.c_str());
-        return 1;
-    }
-    if (a.width != b.width || a.height != b.height) {
-        std::fprintf(stderr, "error: image sizes differ: %dx%d vs %dx%d\n", a.width, a.height,
-                     b.width, b.height);
-        return 1;
-    }
+    if (!read(testPath, &a) || !read(refPath, &b)) return 1;
+    if (!sameSize(a, b)) return 1;
     double mean = 0, refMean = 0;
     for (size_t i = 0; i < a.pixels.size(); ++i) {
         mean += a.pixels[i];
@@ -52,4 +57,52 @@ int main(int argc, char** argv) {
                 relMseTrimmed(a, b), blockBias(a, b), hasNonFinite(a) ? "true" : "false", mean,
                 refMean);
     return 0;
+}
+
+// LEFT | gap | RIGHT on a black background, each caption in white on a strip below its
+// image (font scale 2 for images at least 200 pixels wide, else 1).
+int sideBySide(const char* leftPath, const char* rightPath, const char* outPath,
+               std::string leftCaption, std::string rightCaption) {
+    Image a, b;
+    if (!read(leftPath, &a) || !read(rightPath, &b)) return 1;
+    if (!sameSize(a, b)) return 1;
+    for (std::string* c : {&leftCaption, &rightCaption})
+        std::replace(c->begin(), c->end(), '|', '\n');
+    const int gap = 4, pad = 6, scale = a.width >= 200 ? 2 : 1;
+    const bool captions = !leftCaption.empty() || !rightCaption.empty();
+    const int lines = std::max(captionLines(leftCaption), captionLines(rightCaption));
+    const int strip = captions ? 2 * pad + (lines * CaptionLineHeight - 2) * scale : 0;
+    Image out;
+    out.width = 2 * a.width + gap;
+    out.height = a.height + strip;
+    out.channels = 3;
+    out.pixels.assign(size_t(out.width) * out.height * 3, 0.f);
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                out.at(x, y, c) = a.at(x, y, c);
+                out.at(a.width + gap + x, y, c) = b.at(x, y, c);
+            }
+    drawCaption(&out, pad, a.height + pad, leftCaption, scale, 1.f);
+    drawCaption(&out, a.width + gap + pad, a.height + pad, rightCaption, scale, 1.f);
+    for (const std::string* c : {&leftCaption, &rightCaption})
+        if (captionWidth(*c, scale) > a.width - pad)
+            std::fprintf(stderr, "warning: caption \"%s\" is wider than its image\n", c->c_str());
+    return write(outPath, out) ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string cmd = argc > 1 ? argv[1] : "";
+    if (cmd == "compare" && argc == 4) return compare(argv[2], argv[3]);
+    if (cmd == "convert" && argc == 4) {
+        Image a;
+        return read(argv[2], &a) && write(argv[3], a) ? 0 : 1;
+    }
+    if (cmd == "side-by-side" && (argc == 5 || argc == 7))
+        return sideBySide(argv[2], argv[3], argv[4], argc == 7 ? argv[5] : "",
+                          argc == 7 ? argv[6] : "");
+    std::fprintf(stderr, "%s", kUsage);
+    return 2;
 }
