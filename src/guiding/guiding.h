@@ -282,59 +282,10 @@ inline TrainingSlot GuidingField::slot(int index) { return TrainingSlot(this, in
 
 // The factory: the only place that names backends. "none" returns nullptr with *error empty
 // (parameters are ignored). Unknown backend or parameter, or a bad value => nullptr and a
-// message in *error. Backend "hemi" parameters:
-//   alpha        "visits" (default: 1/(1+visits), batch running mean) or a number in (0,1]
-//   strata       "WxH" (default 16x16): W columns in phi, H rows in
-//                cos(theta), each 1..64;
-//                "N" means NxN
-//   points       surface samples, 1..2^26 (default 1024); each gives two hemispheres (n, -n)
-//   normal-angle admissible normal deviation in degrees, (0, 180) (default 30)
-//   init         initial Q, positive and <= 3.4e38 (default 1e-3)
-//   epsilon      uniform share mixed into every CDF, [0, 1] (default 0.1)
-//   knn          nearest points checked for an admissible normal, 1..64 (default 8)
-//   lookup       "patch" (default): the knn points nearest to the centre of the vertex's
-//                surface patch (setPatches; pieces of the points' mean spacing), memoised per
-//                patch, and "cell" where the vertex has no patch or that point is not
-//                admissible; "cell": the knn points nearest to the centre of the vertex's
-//                grid cell (cells of the points' mean spacing), memoised per cell; "exact":
-//                the knn points nearest to the vertex (kd-tree query per vertex)
-//   warmup       records per stratum until a region's policy gets the full mixture weight:
-//                confidence = visits / (visits + warmup * strata), [0, 1e9] (default 8;
-//                0 = always full weight, the paper's behaviour)
-//   smooth       prior strength, in visits, of the hierarchical smoothing of the strata
-//                estimates, [0, 1e9] (default 2; 0 = off, each stratum its own Q)
-//   max-mb       refuse configurations whose tables would exceed this many MiB
-//                (default 4096)
-//   mix, target, samples, auto, rr, rr-window, learn
-//                consumed by the integrator and the render loop; accepted and ignored here
-//                ("target=path|sample|sum": train on the path's returns, the default, or
-//                on Eq. 1's bootstrap; "samples=independent": a sample set per pass;
-//                "auto=N": the guided-or-plain trial; "rr=adjoint|pbrt" and "rr-window=w":
-//                the integrator's roulette; "learn=N": learning in the first N spp only;
-//                "mix=learn" makes the integrator
-//                record selection samples, from which every backend learns selection() per
-//                region)
-// Backend "vdb" (guiding/vdb.h): the same learning per active voxel of an OpenVDB grid.
-// Parameters alpha, strata, init, epsilon, cosine, smooth, max-mb, mix, target as hemi, and
-//   voxel        N: N voxels along the longest axis of the scene bounds, 1..4096
-//   voxel-size   the voxel edge in world units, > 0 (not with voxel)
-//                (default for both: the edge that gives about 1024 voxels' worth of surface,
-//                sqrt(totalArea / 1024), clamped to [longest / 1024, longest / 4]; fewer
-//                regions learn faster, as hemi's points: 64 spp relMSE, seeds 2/3,
-//                veach-bidir 0.237/0.259 -> 0.193/0.223, breakfast 5.59/5.92 -> 5.62/4.48,
-//                killeroo 0.00051/0.00051 -> 0.00049/0.00050, buddha-fractal equal)
-//   points       surface samples that activate voxels, 1..2^26 (default: 16 per voxel's
-//                worth of surface area, at least 65536, at most 2^24)
-//   dirs         "hemi" (default): two hemispheres per voxel, around its mean normal and its
-//                opposite; "sphere": one full-sphere table per voxel
-//   volume       1 (default) or 0: guide at medium vertices (scenes with media only) with
-//                full-sphere tables (2 x strata) on a second grid over the media bounds,
-//                whose voxels are activated where paths scatter (guiding/vdb_volume.h)
-//   volume-voxel N: N voxels along the longest axis of the media bounds, 1..1024
-//                (default 32); max-mb caps the number of activated voxels
-//   volume-strata the medium tables' strata per hemisphere, as strata (default 8x8, whatever
-//                the surface tables use)
-//   volume-warmup the medium tables' warmup, as warmup (default 16)
+// message in *error. The keys each backend takes, their defaults and accepted values are the
+// one table of guiding/options.h (`rlpbrt --guide-options`; docs/GUIDING.md says what each
+// does and the measurement behind its default). Keys owned by the integrator (mix, target,
+// samples, auto, rr, rr-window, learn) are accepted and ignored here.
 std::unique_ptr<GuidingField> createGuidingField(const GuideConfig& config,
                                                  const SceneInfo& scene, std::string* error);
 

@@ -196,8 +196,8 @@ int HemiField::prefetched(int region) const {
     // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
     // targets): a read without the prefetch waits (cornell-box, 64 spp, perf: radiance() 705
     // -> 27 samples, prefetched() 0 -> 394, lookup() 789 -> 501, of about 15000). The
-    // roulette's policyRadiance reads the CDF instead: 16 prefetches less, -4.2% time
-    // (0.942 .. 0.974) with target=path (docs/BENCHMARKS.md, session 14).
+    // roulette's policyRadiance reads the CDF instead, so with target=path they are not
+    // prefetched (docs/BENCHMARKS_HISTORY.md, session 14).
     if (prefetchEstimates_) {
         prefetchLines(table_.estimates(size_t(region)), size_t(strata_) * sizeof(float));
     }

@@ -26,27 +26,12 @@ namespace rlpbrt::guiding {
 struct HemiParams {
     bool alphaVisits = true;     // alpha = 1/(1 + visits) if true, else fixedAlpha
     double fixedAlpha = 1.0;     // in (0, 1]
+    // Defaults and the measurements behind them: docs/GUIDING.md, one row per key.
     // Strata in phi and in cos(theta). 16x16, not the paper's 8x8: a trained 16x16 guide
-    // resolves the small bright patches that light indirectly lit scenes. Per sample with a
-    // guide trained for 1024 spp (64 spp, seeds 2/3, relMSE): veach-bidir 0.116/0.110 (8x8)
-    // -> 0.062/0.062, breakfast 3.87/4.03 -> 3.20/2.78. At 30 s against none with warmup 8
-    // and smooth 2 (pinned pairs, both core orders, docs/BENCHMARKS.md): veach-bidir 0.53 ->
-    // 0.40, breakfast 0.58 -> 0.51, metal-spheres 1.11 -> 1.02, cornell-box 1.07 -> 1.08,
-    // killeroo 1.10 -> 1.12, conference-room 1.08 -> 1.12.
+    // resolves the small bright patches that light indirectly lit scenes.
     int cols = 16, rows = 16;
-    // Surface samples (two hemispheres each). Fewer regions learn faster: measured relMSE
-    // (64 spp, seeds 2/3/4) veach-bidir 0.255/0.307/0.279 with 8192 points against
-    // 0.185/0.195/0.191 with 2048 (and 0.0644 against 0.0475 at 256 spp), breakfast
-    // 6.92/6.28 against 5.28/5.66, killeroo 0.00053/0.00052 against 0.00051/0.00050,
-    // buddha-fractal 0.0225/0.0232 against 0.0226/0.0231 (docs/BENCHMARKS.md). 1024 since
-    // the patch lookup (session 17): the cell memo had left many points without a cell
-    // (veach-bidir: 1161 regions learned of 2048 points' 4096), and with every point in use
-    // 2048 points learned slower (veach-bidir 64 spp, seeds 2-5: cell 0.142/0.141/0.139/0.129,
-    // patches with 2048 points 0.154/0.163/0.147/0.141, with 1024 0.137/0.143/0.144/0.131).
-    // At equal time (about 30 s of a core, both core orders, docs/BENCHMARKS.md) 1024 points
-    // match or beat 2048 where guiding matters (veach-bidir 0.38/0.37 against 0.39/0.38 of
-    // none's relMSE, breakfast 0.49/0.49 against 0.49/0.47, conference-room 0.86/0.87
-    // against 1.00/0.88), with half the tables; 512 lose breakfast (0.52/0.51).
+    // Surface samples (two hemispheres each). Fewer regions learn faster; 1024 since every
+    // point is in use with the patch lookup, where 2048 learned slower and 512 lost breakfast.
     uint64_t points = 1024;
     double normalAngleDeg = 30;  // admissible normal deviation
     double init = 1e-3;          // initial Q
@@ -54,33 +39,23 @@ struct HemiParams {
     int knn = 8;                 // neighbours checked by lookup
     // Sample strata in proportion to Q_j cos(theta_j) (the cosine to the region normal at the
     // stratum centre) instead of Q_j: the product with the cosine factor of every BSDF's
-    // integrand, which sampling by Q alone spends on grazing directions. Measured at 64 spp:
-    // cornell-box relMSE 0.00105 -> 0.00091, veach-bidir 0.426 -> 0.347.
+    // integrand, which sampling by Q alone spends on grazing directions.
     bool cosine = true;
     // Confidence of a region = visits / (visits + warmup * strata): the integrator scales its
-    // mixture probability by it, so barely trained regions sample mostly the BSDF. Measured at
-    // 64 spp with 8x8 strata (relMSE; none: 0.331, 6.95, 0.0176): warmup 1 -> veach-bidir
-    // 0.345, breakfast 4.46, buddha-fractal 0.0215; 8 -> 0.266, 5.42, 0.0208; 16 -> 0.251,
-    // 5.75, 0.0202. With 16x16 strata, 8 (2048 records per region for confidence 1/2; 1024 at
-    // 8x8 and 16): at 30 s against none veach-bidir 0.42 / 0.39 / 0.47 with warmup 4 (and
-    // smooth 2) / 8 / 16 (both without), breakfast 0.56 / 0.48 / 0.53, cornell-box 1.10 /
-    // 1.10 / 1.17, killeroo 1.19 / 1.04 / 1.09 (three runs at different times of day: the
-    // machine's speed varied by 20%).
+    // mixture probability by it, so barely trained regions sample mostly the BSDF.
     double warmup = 8.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree
-    // query at every vertex, from the vertex itself. The memo is a lookup at about a third of
-    // the cost (cornell-box, hemi 32 spp: 4.41 -> 3.83 s) and the guides equal per sample
-    // (64 spp relMSE, seeds 2/3: veach-bidir 0.168/0.176 -> 0.165/0.159, breakfast 5.73/5.08
-    // -> 5.27/4.49, buddha-fractal, killeroo, cornell-box within 1.5%).
+    // query at every vertex, from the vertex itself; the memo costs a third of that and
+    // guides as well per sample.
     bool cellLookup = true;
     // lookup=patch (the default): where the integrator names the vertex's surface patch
     // (setPatches: pieces about as large as the cells), the knn points nearest to the patch's
     // centre, memoised per patch, are checked against the patch's normal once; the first
     // admissible one answers the vertex if it is admissible for the vertex's normal too (else,
     // and off patches, the cell memo). A patch's memo is one word, found from the hit without
-    // hashing or probing (docs/BENCHMARKS.md, session 17).
+    // hashing or probing.
     bool patchLookup = true;
     // The integrator's target (the "target" parameter, which it validates): "path" (the
     // default) reads no estimates per vertex; "sample" and "sum" read them for Eq. 1's
@@ -89,13 +64,10 @@ struct HemiParams {
     // Prior strength, in visits, of the hierarchical smoothing of the strata estimates
     // (StrataTable::setSmoothing over StrataLayout::quadtree): a stratum with few visits
     // borrows the mean of the 2x2, 4x4, ... strata around it instead of keeping init. 0 = off
-    // (each stratum its own Q, the paper's). Its measured effect is on the bias of the
-    // default samples=sequence (docs/STABILITY.md): an unvisited stratum no longer looks
-    // dark, so the samples a pixel's sequence places where its earlier samples did not go do
-    // not meet a policy that learned to avoid those directions. White furnace, 64 spp, seeds
-    // 1-4, image mean against the exact value: 16x16 strata, warmup 8: +0.049% to +0.074% ->
-    // -0.007% to +0.005%; 8x8, warmup 16: +0.016% to +0.037% -> -0.001% to +0.012%. At equal
-    // time (30 s) it is within the noise of the runs (docs/BENCHMARKS.md).
+    // (each stratum its own Q, the paper's). It removes most of the bias of the default
+    // samples=sequence (docs/STABILITY.md): an unvisited stratum no longer looks dark, so the
+    // samples a pixel's sequence places where its earlier samples did not go do not meet a
+    // policy that learned to avoid those directions.
     double smooth = 2.0;
 };
 

@@ -2,7 +2,7 @@
 // backend's lookup. A complete, implicitly indexed binary tree (median splits on the widest
 // axis, leaves of at most kLeafSize points stored contiguously) with an iterative, stack-based
 // search: measured at 1.7x the speed of nanoflann's KDTreeSingleIndexAdaptor on the same
-// 8192 surface points (docs/BENCHMARKS.md), and the lookup runs at every guided path vertex.
+// 8192 surface points (docs/BENCHMARKS_HISTORY.md, "vdb guiding backend"), and the lookup runs at every guided path vertex.
 #pragma once
 
 #include <cstddef>

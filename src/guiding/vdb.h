@@ -22,12 +22,9 @@ namespace rlpbrt::guiding {
 struct VdbParams {
     bool alphaVisits = true;
     double fixedAlpha = 1.0;
-    // Surface strata. 16x16 with warmup 8, as hemi's (HemiParams::cols), against 8x8 with
-    // warmup 16, both rendered at the same time for 30 s (pinned pairs, both core orders,
-    // relMSE ratio, docs/BENCHMARKS.md): veach-bidir 0.74 / 0.74; within the runs' noise
-    // elsewhere (breakfast 1.01 / 1.05, conference-room 1.08 / 0.98, caustic-glass 1.06 /
-    // 1.00, cornell-box 1.00 / 1.05, killeroo 0.97 / 1.01, metal-spheres 1.03 / 0.99, cloud
-    // 0.97 / 1.07). Memory 11-22 MiB instead of 3.5-6.2.
+    // Surface strata: 16x16 with warmup 8, as hemi's (HemiParams::cols); against 8x8 with
+    // warmup 16 it won on veach-bidir and was within noise elsewhere, at three times the
+    // memory (docs/GUIDING.md, `strata`).
     int cols = 16, rows = 16;
     double voxelSize = 0.0;   // world units; 0: from voxelCount or the scene-derived default
     int voxelCount = 0;       // voxels along the longest axis; 0: not given
@@ -40,15 +37,14 @@ struct VdbParams {
     double normalAngleDeg = 30;  // normal clustering angle and lookup's admissible deviation
     double warmup = 8.0;      // confidence = visits / (visits + warmup * strata), as hemi
     // Hierarchical smoothing of the strata estimates, as hemi's (HemiParams::smooth), for the
-    // surface and the volume tables. White furnace, 64 spp, 40 seeds, image mean against the
-    // exact value (samples=sequence's bias, docs/STABILITY.md): +0.017% +- 0.002% without,
-    // -0.001% +- 0.002% with K = 2.
+    // surface and the volume tables: it removes samples=sequence's bias on a white furnace
+    // (docs/STABILITY.md).
     double smooth = 2.0;
     bool volume = true;       // guide at medium vertices (when the scene has media)
     int volumeVoxels = 32;    // volume voxels along the longest axis of the media bounds
-    // The medium cells' full-sphere tables: 2 x 8 x 8 strata and warmup 16. With the surface
-    // tables' 16x16 and warmup 8 they grew to 85 MiB on cloud and lost there (30 s against
-    // none: 1.13 / 1.08, against 1.05 / 1.06 with these).
+    // The medium cells' full-sphere tables: 2 x 8 x 8 strata and warmup 16; the surface
+    // tables' 16x16 and warmup 8 grew too large on cloud and lost there (docs/GUIDING.md,
+    // `volume-strata`).
     int volumeCols = 8, volumeRows = 8;
     double volumeWarmup = 16.0;
     uint64_t volumeMaxVoxels = uint64_t(1) << 20;  // from max-mb

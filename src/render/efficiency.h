@@ -38,7 +38,7 @@ public:
     // the earlier passes from hiding this pass's variance; the trimmed mean of relMseTrimmed
     // drops exactly the pixels where a pass of few samples caught rare light (it judged
     // plain rendering better on veach-bidir and breakfast, where guiding wins), and a plain
-    // mean is decided by single samples (docs/BENCHMARKS.md, "Guided or plain: a trial").
+    // mean is decided by single samples (docs/BENCHMARKS_HISTORY.md, session 5, "A guided-or-plain trial").
     double relativeVariance(const PassMoments& reference) const;
 
 private:

@@ -49,11 +49,8 @@ struct GuideSettings {
     // passes after them sample from the guide as it is then, without recording targets or
     // updating it between passes (no learning work; the image stays consistent, as with any
     // fixed guide). -1 (learn=all, the default): learn in every pass, as the paper does.
-    // learn=0 with --guide-load renders with a guide trained before. Not the default: at 64
-    // spp, learn=16 saves 2-6% of the time (pinned pairs: cornell-box 0.938, veach-bidir
-    // 0.978, killeroo 0.976) and loses more per sample (relMSE, seeds 2/3: cornell-box
-    // 0.000653/0.000659 -> 0.000718/0.000722, veach-bidir 0.143/0.141 -> 0.167/0.181,
-    // breakfast 4.48/4.66 -> 4.57/5.10, killeroo equal; docs/BENCHMARKS.md).
+    // learn=0 with --guide-load renders with a guide trained before. Not the default: it
+    // saves a few percent of the time and loses more per sample (docs/GUIDING.md, `learn`).
     int learnSpp = -1;
     // With Eq. 1's targets (target=sum|sample, pathTarget false): how the sum of Eq. 1 is
     // evaluated at a non-Lambertian vertex y: over all strata
@@ -66,31 +63,22 @@ struct GuideSettings {
     // return, as practical path guiding trains; emission hit by the direction carries its MIS
     // weight against next-event estimation), instead of Eq. 1's bootstrap from Q at the next
     // vertex. The guide then learns what direction sampling has to find, not light that
-    // next-event estimation already delivers. Measured at 64 spp, seeds 2/3, relMSE:
-    // cornell-box 0.000896/0.000891 (Eq. 1) -> 0.000744/0.000743, conference 0.000311/0.000318
-    // -> 0.000288/0.000292, breakfast 5.27/4.49 -> 4.10/3.97, veach-bidir 0.165/0.159 ->
-    // 0.170/0.163 (none: about 0.00090, 0.00029, 6 and 0.33).
+    // next-event estimation already delivers (docs/GUIDING.md, `target`).
     bool pathTarget = true;
     // Where a guided render's passes take their samples (samples=sequence|independent):
     // from the one low-discrepancy sequence per pixel that plain rendering uses (false, the
     // default), or from an independently randomized set per pass (true). The sequence
-    // keeps the stratification across passes: at 64 spp, hemi relMSE metal-spheres 0.00392
-    // -> 0.00266 (none: 0.00264), buddha-fractal 0.0226 -> 0.0179, veach-bidir 0.181 ->
-    // 0.168. Its price is a correlation between the policy (learned from earlier passes)
-    // and the samples that follow them in the same pixel: a bias that vanishes as the
-    // policy converges, +0.044% / +0.029% / +0.008% at 16 / 64 / 256 spp on a white
-    // furnace (docs/STABILITY.md). Independent sets are exactly unbiased.
+    // keeps the stratification across passes (docs/GUIDING.md, `samples`). Its price is a
+    // correlation between the policy (learned from earlier passes) and the samples that
+    // follow them in the same pixel: a bias that vanishes as the policy converges
+    // (docs/STABILITY.md). Independent sets are exactly unbiased.
     bool independentPasses = false;
     // auto=N (render loop): after about N samples per pixel (or a quarter of a time budget),
     // render one plain pass as large as the guided pass before it, compare the two passes'
     // costs (relative variance per sample times CPU seconds per sample, render/efficiency.h)
     // and render the rest without guiding (no lookups, no learning) if the guided cost
-    // exceeds 1.15 times the plain one. 0 = always guide (the default). Measured with Eq. 1's
-    // targets at N = 16, 96 spp, seeds 1/2/3 (guided/plain cost): killeroo 1.45/1.47/1.38,
-    // cornell-box 1.38/1.43/1.35, conference 1.23/1.27/1.24, veach-bidir 0.56/1.05/1.10,
-    // breakfast 0.62/3.24/0.45. With the path targets the trial misjudges: it measured
-    // 0.74-1.05 on conference, killeroo, cornell-box and veach-mis, which lose 1.16-1.37x at
-    // 30 s, and 2.3 on breakfast, which wins 0.78x (docs/BENCHMARKS.md); not the default.
+    // exceeds 1.15 times the plain one. 0 = always guide (the default): with the path
+    // targets the trial misjudges which scenes win (docs/GUIDING.md, `auto`).
     int autoSpp = 0;
     // rr=adjoint: from the second surface vertex on, guided surface vertices play Russian
     // roulette on the path's expected remaining contribution, throughput x the learned Q of
@@ -100,11 +88,8 @@ struct GuideSettings {
     // chose a bright direction. Untrained regions and pixels without an estimate (the render
     // loop gives none before 8 samples per pixel) keep pbrt-v3's roulette (after bounce 3).
     // rr=pbrt: pbrt-v3's everywhere.
-    // Per sample it costs some variance (killeroo, 64 spp: relMSE 0.000313 -> 0.000329 when
-    // it starts at the second vertex instead of after bounce 3) and saves more time (5.9 ->
-    // 5.2 s); at 30 s against none it took breakfast 0.51 -> 0.40, conference-room 1.12 ->
-    // 0.96, killeroo 1.12 -> 1.05, cornell-box 1.08 -> 1.04 (docs/BENCHMARKS.md, session 9).
-    // Starting at the first vertex lost per time on killeroo (0.000406 at 4.7 s).
+    // Per sample it costs some variance and saves more time; starting at the first vertex
+    // lost per time (docs/GUIDING.md, `rr`; docs/BENCHMARKS_HISTORY.md, session 9).
     // Like the policy, the estimate comes from earlier samples of the same pixels
     // (GuideSettings::independentPasses).
     bool adjointRoulette = true;
