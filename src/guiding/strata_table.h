@@ -1,9 +1,9 @@
 // The learned part of a guiding field, independent of how regions are placed in space: per
 // region a table of strata holding Q (double), visit counts, the float estimates that
 // queries read (Q itself, or Q smoothed over a hierarchy of strata) and the frozen sampling
-// CDF; per-slot record buffers and the deterministic slot-ordered batch merge of Eq. 1
-// between passes (notes section 4). Shared by the hemi and vdb backends; standard library and
-// TBB only.
+// CDF; per-slot record buffers and the deterministic slot-ordered batch merge of the
+// records between passes (a running mean per stratum; docs/ARCHITECTURE.md, step 7). Shared
+// by the hemi and vdb backends; standard library and TBB only.
 #pragma once
 
 #include <cmath>

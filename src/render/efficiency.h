@@ -1,7 +1,7 @@
 // The efficiency of a render pass, measured from its own samples: the relative variance of
 // one sample per pixel (normalised as relMseTrimmed normalises errors) times the time one
 // sample took. The render loop compares a guided pass with a plain one this way and stops
-// guiding where it does not pay (GuideSettings::autoOff, render.cpp).
+// guiding where it does not pay (GuideSettings::autoSpp, the auto trial in render.cpp).
 #pragma once
 
 #include <cstddef>
