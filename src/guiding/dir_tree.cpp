@@ -66,6 +66,20 @@ void DirTree::square(uint32_t target, glm::vec2* origin, float* edge) const {
     *edge = e;
 }
 
+std::vector<glm::vec3> DirTree::squares() const {
+    // Parents come before their children: one forward sweep.
+    std::vector<glm::vec3> sq(nodes_.size());
+    sq[0] = glm::vec3(0.f, 0.f, 1.f);
+    for (size_t i = 0; i < nodes_.size(); ++i) {
+        if (nodes_[i].leaf()) continue;
+        const float e = 0.5f * sq[i].z;
+        for (uint32_t k = 0; k < 4; ++k)
+            sq[nodes_[i].child + k] = glm::vec3(sq[i].x + e * float(k & 1),
+                                                sq[i].y + e * float(k >> 1), e);
+    }
+    return sq;
+}
+
 float DirTree::density(glm::vec2 a, uint32_t* leaf) const {
     a.x = clampUnit(a.x);
     a.y = clampUnit(a.y);

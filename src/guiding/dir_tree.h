@@ -52,8 +52,11 @@ public:
     // The leaf whose square holds a (components clamped to [0, 1]; NaN goes to 0); its depth
     // (0: the root) in *depth if given.
     uint32_t leafOf(glm::vec2 a, int* depth = nullptr) const;
-    // The square of node i: its lower corner and edge length.
+    // The square of node i: its lower corner and edge length (a walk over the nodes: for
+    // one node; squares() gives all at once).
     void square(uint32_t i, glm::vec2* origin, float* edge) const;
+    // Every node's square as (origin x, origin y, edge), in node order.
+    std::vector<glm::vec3> squares() const;
     // Density over the unit square at a (integrates to 1 over it): the product over the path
     // from the root of 4 x the child's share of its parent's mass (a quarter each where the
     // parent's mass is 0). *leaf (if given) receives a's leaf.
