@@ -185,6 +185,18 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
                 return badValue("hemi", key, value, error);
             hp->cellLookup = value != "exact";
             hp->patchLookup = value == "patch";
+        } else if (key == "directions") {
+            if (value != "strata" && value != "tree") return badValue("hemi", key, value, error);
+            hp->treeDirections = value == "tree";
+        } else if (key == "tree-split") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || !(d > 0.0) || d > 1.0)
+                return badValue("hemi", key, value, error);
+            hp->treeSplit = d;
+        } else if (key == "tree-depth") {
+            if (!parseUnsigned(value, uint64_t(DirTree::kMaxDepth), &u) || u < 1)
+                return badValue("hemi", key, value, error);
+            hp->treeDepth = int(u);
         } else {
             return unknownParam("hemi", key, error);
         }

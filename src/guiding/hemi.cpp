@@ -88,6 +88,17 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
     if (params.smooth > 0.0)
         table_.setSmoothing(layout_.quadtree(), params.smooth);
     table_.reset(regions, strata_, params.init, policy(), /*lazy=*/true);
+    if (params.treeDirections) {
+        TreeTable::Settings ts;
+        ts.init = params.init;
+        ts.epsilon = params.epsilon;
+        ts.splitShare = params.treeSplit;
+        ts.maxDepth = params.treeDepth;
+        ts.cosine = params.cosine;
+        ts.smooth = params.smooth;
+        trees_ = std::make_unique<TreeTable>();
+        trees_->reset(regions, ts);
+    }
     // (reset built region 0 and copied it to the others)
     if (regions > 0) {
         std::vector<double> est(static_cast<size_t>(strata_));
@@ -205,6 +216,17 @@ int HemiField::prefetched(int region) const {
 }
 
 float HemiField::pdf(int region, const glm::vec3& w, int* bin) const {
+    if (trees_) {
+        glm::vec2 a;
+        if (!treePoint(region, w, &a)) {
+            if (bin) *bin = -1;
+            return 0.f;
+        }
+        uint32_t leaf = 0;
+        const float d = trees_->density(size_t(region), a, &leaf);
+        if (bin) *bin = int(leaf);
+        return d * (1.f / TwoPi);
+    }
     const int j = stratumOf(region, w);
     if (bin) *bin = j;
     if (j < 0) return 0.f;
@@ -217,6 +239,18 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfO
         *pdfOut = 0.f;
         if (bin) *bin = -1;
         return glm::vec3(0.f);
+    }
+    if (trees_) {
+        float d = 0.f;
+        const glm::vec2 a = trees_->sample(size_t(region), u, uStratum, &d);
+        const glm::vec3 w = glm::normalize(
+            frames_[size_t(region)].frame.toWorld(DirTree::hemisphereDirection(a)));
+        // The pdf of the direction as pdf() finds it (the round trip through the frame may
+        // move it to a neighbouring leaf); on the horizon keep the drawn density.
+        float p = pdf(region, w, bin);
+        if (!(p > 0.f)) p = d * (1.f / TwoPi);
+        *pdfOut = p;
+        return w;
     }
     const float* c = cdf(region);
     int j = sampleStrataCdf(c, strata_, uStratum);
@@ -245,6 +279,20 @@ float HemiField::scatteredEstimate(int region,
                                    const std::function<float(const glm::vec3&)>& fcos) const {
     if (!validRegion(region)) return 0.f;
     const Frame& frame = frames_[size_t(region)].frame;
+    if (trees_) {
+        // Over the leaves: Q x fcos at the leaf's centre x its solid angle.
+        const DirTree& t = trees_->tree(size_t(region));
+        const std::vector<glm::vec3> sq = t.squares();
+        double acc = 0.0;
+        for (uint32_t i = 0; i < t.size(); ++i) {
+            if (!t.node(i).leaf()) continue;
+            const glm::vec2 centre(sq[i].x + 0.5f * sq[i].z, sq[i].y + 0.5f * sq[i].z);
+            const float f = fcos(frame.toWorld(DirTree::hemisphereDirection(centre)));
+            if (f > 0.f && std::isfinite(f))
+                acc += double(trees_->radiance(size_t(region), i)) * f * sq[i].z * sq[i].z;
+        }
+        return float(std::min(acc * TwoPi, double(FLT_MAX)));
+    }
     const float* q = table_.estimates(size_t(region));
     double acc = 0.0;
     for (int j = 0; j < strata_; ++j) {
@@ -263,6 +311,7 @@ float HemiField::irradianceEstimate(int region, const glm::vec3& n) const {
 }
 
 float HemiField::confidence(int region) const {
+    if (trees_) return validRegion(region) ? trees_->confidence(size_t(region), params_.warmup) : 0.f;
     return validRegion(region) ? frames_[size_t(region)].confidence : 0.f;
 }
 
@@ -275,12 +324,19 @@ void HemiField::recordSelection(int slot, int region, const SelectionSample& s) 
 }
 
 float HemiField::radiance(int region, const glm::vec3& w, int bin) const {
+    if (trees_) {
+        if (!validRegion(region)) return 0.f;
+        if (bin >= 0 && size_t(bin) < trees_->tree(size_t(region)).size())
+            return trees_->radiance(size_t(region), uint32_t(bin));
+        glm::vec2 a;
+        return treePoint(region, w, &a) ? trees_->radianceAt(size_t(region), a) : 0.f;
+    }
     const int j = stratumOf(region, w, bin);
     return j < 0 ? 0.f : table_.estimates(size_t(region))[j];
 }
 
 float HemiField::policyRadiance(int region, const glm::vec3& w, int bin) const {
-    if (prefetchEstimates_) return radiance(region, w, bin);  // exact, and as cheap
+    if (prefetchEstimates_ || trees_) return radiance(region, w, bin);  // exact, and as cheap
     const int j = stratumOf(region, w, bin);
     if (j < 0) return 0.f;
     const float* c = cdf(region);
@@ -289,9 +345,18 @@ float HemiField::policyRadiance(int region, const glm::vec3& w, int bin) const {
     return q > 0.f ? std::min(q, FLT_MAX) : 0.f;  // (NaN -> 0)
 }
 
-void HemiField::beginPass(int numSlots) { table_.beginPass(numSlots); }
+void HemiField::beginPass(int numSlots) {
+    table_.beginPass(numSlots);
+    if (trees_) trees_->beginPass(numSlots);
+}
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
+    if (trees_) {
+        glm::vec2 a(-1.f);  // outside the square: counted as rejected
+        treePoint(region, w, &a);
+        trees_->record(slot, validRegion(region) ? uint32_t(region) : UINT32_MAX, a, target);
+        return;
+    }
     table_.record(slot, region, target, [&] { return stratumOf(region, w, bin); });
 }
 
@@ -333,10 +398,36 @@ void HemiField::buildPolicy(const double* q, float* cdf) const {
     buildStrataCdf(qc, strata_, params_.epsilon, cdf);
 }
 
-void HemiField::endPass() { table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy()); }
+void HemiField::endPass() {
+    table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
+    if (trees_) {
+        trees_->endPass();
+        updateTreeRegions();
+    }
+}
+
+void HemiField::updateTreeRegions() {
+    // The moment sum over leaves of Q x direction x solid angle, for irradianceEstimate; the
+    // confidence is the trees' own (confidence()).
+    for (size_t r = 0; r < frames_.size(); ++r) {
+        if (!(trees_->visits(r) > 0.0)) continue;
+        const DirTree& t = trees_->tree(r);
+        const std::vector<glm::vec3> sq = t.squares();
+        glm::dvec3 m(0.0);
+        for (uint32_t i = 0; i < t.size(); ++i) {
+            if (!t.node(i).leaf()) continue;
+            const glm::vec2 centre(sq[i].x + 0.5f * sq[i].z, sq[i].y + 0.5f * sq[i].z);
+            m += glm::dvec3(DirTree::hemisphereDirection(centre)) *
+                 (double(trees_->radiance(r, i)) * sq[i].z * sq[i].z * TwoPi);
+        }
+        const Frame& f = frames_[r].frame;
+        const glm::vec3 world = f.toWorld(glm::vec3(m));
+        frames_[r].moment = finite3(world) ? world : glm::vec3(0.f);
+    }
+}
 
 size_t HemiField::bytes() const {
-    return table_.bytes() + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
+    return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
            frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +
            (cache_ ? cache_->bytes() : 0) + size_t(numPatches_) * sizeof(uint32_t);
 }
@@ -371,6 +462,15 @@ std::string HemiField::describe() const {
                       cache_->size(), cache_->capacity());
         line += buf;
     }
+    if (trees_) {
+        size_t leaves = 0;
+        for (size_t r = 0; r < size_t(numRegions()); ++r) leaves += trees_->tree(r).leaves();
+        std::snprintf(buf, sizeof(buf),
+                      "; directions=tree (split %g, depth %d): %zu leaves in all, %.1f MiB",
+                      params_.treeSplit, params_.treeDepth, leaves,
+                      double(trees_->bytes()) / (1024.0 * 1024.0));
+        line += buf;
+    }
     if (numPatches_ > 0) {
         std::snprintf(buf, sizeof(buf), "; %u surface patches", numPatches_);
         line += buf;
@@ -385,12 +485,16 @@ std::string HemiField::describe() const {
 }
 
 GuidingStats HemiField::stats() const {
-    GuidingStats s = table_.stats();
+    GuidingStats s = trees_ ? trees_->stats() : table_.stats();
     s.learnedRegions = learnedRegions();
     return s;
 }
 
 bool HemiField::save(const std::string& path, std::string* error) const {
+    if (trees_) {
+        *error = "hemi with directions=tree cannot be saved yet";
+        return false;
+    }
     fieldio::Writer w;
     w.raw(fieldio::kMagic, 8);
     w.u32(fieldio::kVersion);
@@ -418,6 +522,10 @@ bool HemiField::save(const std::string& path, std::string* error) const {
 }
 
 bool HemiField::load(const std::string& path, std::string* error) {
+    if (trees_) {
+        *error = "hemi with directions=tree cannot load a saved field yet";
+        return false;
+    }
     const std::string kind = fieldio::fileKind(path);
     if (kind.empty()) {
         *error = "'" + path + "' is not a saved guiding field (or cannot be read)";

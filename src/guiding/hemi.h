@@ -19,6 +19,7 @@
 #include "guiding/guiding.h"
 #include "guiding/kdtree.h"
 #include "guiding/strata_table.h"
+#include "guiding/tree_table.h"
 
 namespace rlpbrt::guiding {
 
@@ -69,6 +70,13 @@ struct HemiParams {
     // samples a pixel's sequence places where its earlier samples did not go do not meet a
     // policy that learned to avoid those directions.
     double smooth = 2.0;
+    // directions=tree (issue 30, experimental): each hemisphere's directions are an adaptive
+    // quadtree (guiding/tree_table.h) refined where its learned light concentrates, instead
+    // of the fixed strata; treeSplit and treeDepth are DirTree::refined's share and depth.
+    // strata, smooth and --guide-save do not apply to it.
+    bool treeDirections = false;
+    double treeSplit = 0.03;
+    int treeDepth = 12;
 };
 
 // Estimated bytes of a hemi field with these parameters (tables, CDFs, points, kd-tree).
@@ -133,7 +141,9 @@ public:
     size_t scratchBytes() const;
     // Regions that have received records and hold tables of their own (the others share the
     // untrained prior's).
-    size_t learnedRegions() const { return table_.learnedRegions(); }
+    size_t learnedRegions() const {
+        return trees_ ? size_t(trees_->stats().learnedRegions) : table_.learnedRegions();
+    }
     // Number of regions (hemispheres): twice the number of accepted surface points.
     int numRegions() const { return numRegions_; }
     const StrataLayout& layout() const { return layout_; }
@@ -249,6 +259,17 @@ private:
     // too. With target=path and epsilon < 1 it reads the CDF only (policyRadiance).
     bool prefetchEstimates_ = false;
     StrataTable table_;              // Q, float Q, visits, CDFs, record buffers, counters
+    // directions=tree: the regions' adaptive tables (table_ then keeps only the learned
+    // selections of mix=learn).
+    std::unique_ptr<TreeTable> trees_;
+    // A world direction's point on the square of a region's hemisphere (false: outside).
+    bool treePoint(int region, const glm::vec3& w, glm::vec2* a) const {
+        glm::vec3 unit;
+        if (!validRegion(region) || !unitDirection(w, &unit)) return false;
+        return DirTree::hemispherePoint(frames_[size_t(region)].frame.toLocal(unit), a);
+    }
+    // After the trees' endPass: every learned region's moment and confidence.
+    void updateTreeRegions();
     uint64_t attempts_ = 0;  // samplePoint calls made at construction
 };
 

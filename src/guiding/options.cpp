@@ -63,6 +63,14 @@ const std::vector<GuideOption>& guideOptions() {
         {"lookup", O::kHemi, kField, "patch", "patch, cell or exact",
          "how a vertex finds its point: memo per surface patch, memo per grid cell, or a "
          "kd-tree query per vertex"},
+        {"directions", O::kHemi, kField, "strata", "strata or tree",
+         "each hemisphere's directions: the fixed strata, or an adaptive quadtree refined "
+         "where the learned light concentrates (experimental; no --guide-save)"},
+        {"tree-split", O::kHemi, kField, "0.03", "a number in (0, 1]",
+         "directions=tree: a node splits while it holds more than this share of its "
+         "hemisphere's learned light"},
+        {"tree-depth", O::kHemi, kField, "12", "an integer in 1..16",
+         "directions=tree: the deepest level (leaf edge 2^-depth of the square)"},
         // vdb only.
         {"voxel", O::kVdb, kField, "sqrt(area / 1024) as the edge",
          "a voxel count along the longest axis, 1..4096",

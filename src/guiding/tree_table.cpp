@@ -14,6 +14,7 @@ void TreeTable::reset(size_t regions, const Settings& settings) {
     regions_.assign(regions, Region{});
     for (Region& r : regions_) {
         r.q.assign(1, float(settings_.init));
+        r.est = r.q;
         r.visits.assign(1, 0.0);
     }
     stats_ = GuidingStats{};
@@ -74,11 +75,45 @@ void TreeTable::record(int slot, uint32_t region, glm::vec2 a, float target) {
 
 void TreeTable::setMasses(Region& region) const {
     const DirTree& t = region.tree;
+    const size_t n = t.size();
+    // Visit-weighted Q and visits under every node (children follow their parents), then the
+    // estimates from the root down.
+    std::vector<double> s(n, 0.0), v(n, 0.0);
+    for (size_t i = n; i-- > 0;) {
+        const DirTree::Node& node = t.node(uint32_t(i));
+        if (node.leaf()) {
+            v[i] = region.visits[i];
+            s[i] = v[i] * double(region.q[i]);
+        } else {
+            for (uint32_t k = 0; k < 4; ++k) {
+                s[i] += s[node.child + k];
+                v[i] += v[node.child + k];
+            }
+        }
+    }
+    region.est.assign(n, 0.f);
+    const double prior = settings_.smooth;
+    region.est[0] = float(v[0] > 0.0 ? s[0] / v[0] : double(region.q[0]));
+    if (t.node(0).leaf() && prior <= 0.0) region.est[0] = region.q[0];
+    for (size_t i = 0; i < n; ++i) {
+        const DirTree::Node& node = t.node(uint32_t(i));
+        if (node.leaf()) continue;
+        for (uint32_t k = 0; k < 4; ++k) {
+            const size_t c = node.child + k;
+            double e;
+            if (prior > 0.0)
+                e = (s[c] + prior * double(region.est[i])) / (v[c] + prior);
+            else
+                e = t.node(uint32_t(c)).leaf() ? double(region.q[c])
+                                               : (v[c] > 0.0 ? s[c] / v[c] : region.est[i]);
+            region.est[c] = std::isfinite(e) && e >= 0.0 ? float(e) : region.est[i];
+        }
+    }
     const std::vector<glm::vec3> sq = t.squares();
-    std::vector<float> mass(t.size(), 0.f);
-    for (uint32_t i = 0; i < t.size(); ++i) {
+    std::vector<float> mass(n, 0.f);
+    for (uint32_t i = 0; i < n; ++i) {
         if (!t.node(i).leaf()) continue;
-        float m = region.q[i] * sq[i].z * sq[i].z;
+        float m = region.est[i] * sq[i].z * sq[i].z;
         if (settings_.cosine) m *= sq[i].x + 0.5f * sq[i].z;  // cos(theta) at the centre
         mass[i] = m;
     }
@@ -137,11 +172,14 @@ void TreeTable::applyRegion(Region& region, const Record* begin, const Record* e
         if (!refined.node(i).leaf()) continue;
         const DirTree::Source s = sources[i];
         if (old.node(s.from).leaf()) {
-            // A leaf kept whole keeps its visits. The pieces of a split leaf keep its Q as
-            // their estimate until their own records come, without its visits: those records
+            // A leaf kept whole keeps its visits. The pieces of a split leaf keep its Q with
+            // the weight of at most `smooth` visits (a prior), not its visits: those records
             // fell over the whole leaf, and would hold a piece's mean at the leaf's for long.
             q[i] = region.q[s.from];
-            visits[i] = s.fraction == 1.f ? region.visits[s.from] : 0.0;
+            visits[i] = s.fraction == 1.f
+                            ? region.visits[s.from]
+                            : std::min(region.visits[s.from] * double(s.fraction),
+                                       settings_.smooth);
         } else {
             visits[i] = sumV[s.from];
             q[i] = float(sumV[s.from] > 0.0 ? sumQV[s.from] / sumV[s.from]

@@ -33,6 +33,11 @@ public:
         double splitShare = 0.01;  // DirTree::refined's threshold
         int maxDepth = 12;         // leaves at most this deep (edge 2^-depth of the square)
         bool cosine = false;       // weigh a leaf's mass by its centre's cos(theta) (= a.x)
+        // Prior strength, in visits, of the hierarchical smoothing of the leaves' estimates
+        // (as StrataTable::setSmoothing): a node's estimate is (S + smooth x its parent's) /
+        // (N + smooth) with S and N the visit-weighted Q and the visits under it, so a leaf
+        // with few visits borrows its neighbourhood's light. 0: each leaf its own Q.
+        double smooth = 2.0;
     };
 
     // `regions` single-leaf regions with Q = init, no visits.
@@ -49,8 +54,8 @@ public:
                      uint32_t* leaf = nullptr) const;
     // The mixture's density over the square at a; *leaf (if given) a's leaf.
     float density(size_t region, glm::vec2 a, uint32_t* leaf = nullptr) const;
-    // Q of a leaf of the region (its learned incident radiance), or at a point.
-    float radiance(size_t region, uint32_t leaf) const { return regions_[region].q[leaf]; }
+    // The estimate of a leaf's incident radiance (Q, smoothed), or at a point.
+    float radiance(size_t region, uint32_t leaf) const { return regions_[region].est[leaf]; }
     float radianceAt(size_t region, glm::vec2 a) const {
         return radiance(region, regions_[region].tree.leafOf(a));
     }
@@ -87,11 +92,13 @@ private:
     struct Region {
         DirTree tree;
         std::vector<float> q;          // per node; a leaf's Q (inner entries unused)
+        std::vector<float> est;        // per node; the smoothed estimates (Settings::smooth)
         std::vector<double> visits;    // per node; a leaf's visits (fractional after splits)
         double totalVisits = 0.0;
     };
     void applyRegion(Region& region, const Record* begin, const Record* end) const;
-    // Sets the tree's leaf masses from Q (x area, x cos with settings_.cosine).
+    // Sets the estimates from Q and visits, and the tree's leaf masses from them (x area,
+    // x cos with settings_.cosine).
     void setMasses(Region& region) const;
 
     Settings settings_;

@@ -989,3 +989,68 @@ TEST(HemiField, ConfidenceGrowsWithVisits) {
 
 }  // namespace
 }  // namespace rlpbrt::guiding
+
+namespace rlpbrt::guiding {
+namespace {
+
+// directions=tree: the adaptive quadtree per hemisphere (guiding/tree_table.h) behind the
+// same interface. Sampling against the pdf (chi-square over the sphere), the pdf's integral
+// (over the tree's leaves), a narrow bright cone resolved finer than the strata, bins.
+TEST(HemiField, TreeDirectionsSampleTheirPdfAndResolveANarrowCone) {
+    auto f = test::makeField<HemiField>("hemi", test::planeScene(),
+                                        {{"points", "16"}, {"directions", "tree"}});
+    ASSERT_TRUE(f);
+    const glm::vec3 bright = glm::normalize(glm::vec3(0.3f, -0.2f, 1.f));
+    // A cone of cos > 0.995 (0.1 rad): about a tenth of a 16x16 stratum's solid angle.
+    std::mt19937_64 rng(17);
+    for (int p = 0; p < 6; ++p) {
+        f->beginPass(1);
+        for (int i = 0; i < 40000; ++i) {
+            const glm::vec3 w = test::gaussianDirection(rng);
+            f->record(0, 4, w, glm::dot(w, bright) > 0.995f ? 1000.f : 0.05f);
+        }
+        f->endPass();
+    }
+    // The cone holds about 0.0314 sr x 1000 of the region's light against 6.2 x 0.05 for the
+    // rest: its pdf is far above what a 16x16 stratum (0.0245 sr) could give it.
+    const float inCone = f->pdf(4, bright);
+    EXPECT_GT(inCone, 10.f);
+    EXPECT_LT(f->pdf(4, glm::normalize(glm::vec3(-0.5f, 0.5f, 0.3f))), 0.1f);
+    chi2::SphereResult r = sphereTest(*f, 4, 41, 100000);
+    EXPECT_TRUE(r.passed) << r.message;
+    // The pdf's integral over the hemisphere.
+    double integral = 0.0;
+    {
+        std::mt19937_64 g(5);
+        std::uniform_real_distribution<float> uni(0.f, 1.f);
+        // Monte Carlo over uniform hemisphere directions: E[pdf / (1 / 2pi)] = 1.
+        const Frame frame = Frame::fromZ(f->regionNormal(4));
+        const int n = 400000;
+        for (int i = 0; i < n; ++i) {
+            const glm::vec3 local = DirTree::hemisphereDirection(glm::vec2(uni(g), uni(g)));
+            integral += double(f->pdf(4, frame.toWorld(local))) * 2.0 * 3.14159265358979;
+        }
+        integral /= n;
+    }
+    EXPECT_NEAR(integral, 1.0, 0.02);
+    // A sampled direction's bin is its leaf: radiance() agrees with and without it.
+    for (int i = 0; i < 100; ++i) {
+        float pdf = 0.f;
+        int bin = -1;
+        std::uniform_real_distribution<float> uni(0.f, 1.f);
+        const glm::vec3 w = f->sample(4, glm::vec2(uni(rng), uni(rng)), uni(rng), &pdf, &bin);
+        ASSERT_GE(bin, 0);
+        EXPECT_FLOAT_EQ(pdf, f->pdf(4, w));
+        EXPECT_FLOAT_EQ(f->radiance(4, w, bin), f->radiance(4, w));
+    }
+    // The smoothing (smooth=2) shrinks the cone's few-visit leaves towards their neighbours a
+    // little.
+    EXPECT_GT(f->radiance(4, bright), 800.f);
+    EXPECT_LT(f->radiance(4, bright), 1050.f);
+    std::string error;
+    EXPECT_FALSE(f->save("/tmp/rlpbrt-tree-field.bin", &error));
+    EXPECT_NE(error.find("directions=tree"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rlpbrt::guiding

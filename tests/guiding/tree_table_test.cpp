@@ -66,6 +66,7 @@ TEST(TreeTable, LearnsWhereTheLightIs) {
     TreeTable::Settings s;
     s.splitShare = 0.01;
     s.maxDepth = 10;
+    s.smooth = 0.0;  // each leaf its own mean (the smoothing has its own test)
     t.reset(2, s);
     train(&t, 8, 40000, 1);
     int spotDepth = 0, floorDepth = 0;
@@ -129,6 +130,25 @@ TEST(TreeTable, DensityIntegratesToOneAndSamplesFollowIt) {
     EXPECT_EQ(mismatches, 0);
     const chi2::Result r = chi2::testCounts(observed, expected);
     EXPECT_TRUE(r.passed) << r.message;
+}
+
+// The smoothing: a leaf without visits takes its neighbourhood's estimate, not init; with
+// many visits a leaf keeps its own mean.
+TEST(TreeTable, SmoothingFillsLeavesWithoutVisits) {
+    TreeTable t;
+    TreeTable::Settings s;
+    s.smooth = 2.0;
+    t.reset(1, s);
+    // Pass 1: everything in the lower-left quarter, target 4: the root splits, the empty
+    // quarters borrow the root's mean instead of keeping init.
+    t.beginPass(1);
+    for (int i = 0; i < 1000; ++i)
+        t.record(0, 0, glm::vec2(0.1f + 0.3f * (i % 10) / 10.f, 0.1f + 0.3f * (i / 100) / 10.f), 4.f);
+    t.endPass();
+    EXPECT_GT(t.tree(0).leaves(), 1u);
+    EXPECT_NEAR(t.radianceAt(0, glm::vec2(0.2f, 0.2f)), 4.f, 1e-3f);
+    EXPECT_NEAR(t.radianceAt(0, glm::vec2(0.9f, 0.9f)), 4.f, 1e-3f);
+    EXPECT_NEAR(densityIntegral(t, 0), 1.0, 1e-5);
 }
 
 TEST(TreeTable, RejectsBadRecords) {
