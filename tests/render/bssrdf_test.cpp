@@ -7,8 +7,13 @@
 #include <random>
 
 #include "chi2.h"
+#include "parser/diagnostics.h"
+#include "parser/parser.h"
+#include "render/bsdf.h"
 #include "render/bssrdf.h"
 #include "render/bxdfs.h"
+#include "render/scene.h"
+#include "render/scene_builder.h"
 
 namespace rlpbrt {
 namespace {
@@ -217,6 +222,103 @@ TEST(BSSRDFExitLobe, IsNormalised) {
         EXPECT_NEAR(sum, 1.0, 0.01) << eta;
         EXPECT_EQ(imp.f(wo, Vec3(0, 0, -1)).x, 0.f);
     }
+}
+
+// The materials: the BSDF at a sphere's hit carries the BSSRDF, with pbrt-v3's parameters.
+struct MaterialHit {
+    std::unique_ptr<Scene> scene;  // owns the material, whose table the BSSRDF points to
+    BSDF bsdf;
+    int warnings = 0;
+    bool ok = false;
+};
+MaterialHit materialHit(const std::string& material) {
+    MaterialHit out;
+    Diagnostics diag;
+    diag.setStream(nullptr);
+    SceneBuilder builder(diag);
+    std::string text = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                       "LightSource \"infinite\"\n" +
+                       material + "\nShape \"sphere\" \"float radius\" 1\nWorldEnd\n";
+    if (!parseString(text, "sss.pbrt", builder, diag)) return out;
+    SceneDesc desc = builder.takeDesc();
+    out.scene = buildScene(desc, BuildOptions(), diag);
+    if (!out.scene) return out;
+    SurfaceInteraction si;
+    if (!out.scene->intersect(Ray(Vec3(0.1f, 0.2f, 5.f), Vec3(0, 0, -1)), &si)) return out;
+    out.scene->materials[size_t(si.material)]->computeBSDF(si, 0.5f, &out.bsdf);
+    out.warnings = diag.warningCount();
+    out.ok = true;
+    return out;
+}
+
+TEST(SubsurfaceMaterial, NamedMediumAndCoefficients) {
+    MaterialHit named = materialHit("Material \"subsurface\" \"string name\" \"Ketchup\"");
+    ASSERT_TRUE(named.ok);
+    EXPECT_EQ(named.warnings, 0);
+    const SeparableBSSRDF* b = named.bsdf.subsurface();
+    ASSERT_NE(b, nullptr);
+    EXPECT_FLOAT_EQ(b->eta(), 1.33f);
+    // Smooth boundary by default: one FresnelSpecular lobe (a delta BSDF: no guiding).
+    EXPECT_TRUE(named.bsdf.isDelta());
+    MaterialHit given = materialHit(
+        "Material \"subsurface\" \"rgb sigma_a\" [0.061 0.97 1.45] \"rgb sigma_s\" "
+        "[0.18 0.07 0.03] \"float uroughness\" 0.1 \"float vroughness\" 0.1");
+    ASSERT_TRUE(given.ok);
+    ASSERT_NE(given.bsdf.subsurface(), nullptr);
+    EXPECT_FALSE(given.bsdf.isDelta());
+    for (float r : {0.f, 0.3f, 2.f})
+        EXPECT_EQ(given.bsdf.subsurface()->sr(r), b->sr(r)) << r;
+    // scale multiplies the coefficients: the profile's radii shrink by it.
+    MaterialHit scaled = materialHit(
+        "Material \"subsurface\" \"string name\" \"Ketchup\" \"float scale\" 2");
+    ASSERT_TRUE(scaled.ok);
+    EXPECT_NEAR(scaled.bsdf.subsurface()->rMax(1), 0.5f * b->rMax(1), 1e-5f);
+    // An unknown name: pbrt-v3's defaults, with a warning.
+    MaterialHit unknown = materialHit("Material \"subsurface\" \"string name\" \"Ketchupp\"");
+    ASSERT_TRUE(unknown.ok);
+    EXPECT_EQ(unknown.warnings, 1);
+}
+
+TEST(SubsurfaceMaterial, KdSubsurfaceMfpDefaultsToOneAndIgnoresAFloat) {
+    MaterialHit def = materialHit("Material \"kdsubsurface\" \"rgb Kd\" [0.8 0.5 0.3]");
+    MaterialHit one = materialHit(
+        "Material \"kdsubsurface\" \"rgb Kd\" [0.8 0.5 0.3] \"rgb mfp\" [1 1 1]");
+    // pbrt-v3 reads mfp as a spectrum only: a float is ignored with a warning (mfp 1).
+    MaterialHit flt =
+        materialHit("Material \"kdsubsurface\" \"rgb Kd\" [0.8 0.5 0.3] \"float mfp\" 0.5");
+    ASSERT_TRUE(def.ok && one.ok && flt.ok);
+    EXPECT_EQ(def.warnings, 0);
+    EXPECT_EQ(flt.warnings, 1);
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_EQ(def.bsdf.subsurface()->rMax(ch), one.bsdf.subsurface()->rMax(ch));
+        EXPECT_EQ(flt.bsdf.subsurface()->rMax(ch), one.bsdf.subsurface()->rMax(ch));
+    }
+    MaterialHit half = materialHit(
+        "Material \"kdsubsurface\" \"rgb Kd\" [0.8 0.5 0.3] \"rgb mfp\" [0.5 0.5 0.5]");
+    ASSERT_TRUE(half.ok);
+    EXPECT_NEAR(half.bsdf.subsurface()->rMax(0), 0.5f * one.bsdf.subsurface()->rMax(0), 1e-5f);
+}
+
+TEST(SubsurfaceMaterial, DisneyScatterDistance) {
+    MaterialHit sss = materialHit(
+        "Material \"disney\" \"color color\" [0.8 0.6 0.4] \"color scatterdistance\" "
+        "[0.2 0.3 0.4]");
+    ASSERT_TRUE(sss.ok);
+    EXPECT_EQ(sss.warnings, 0);
+    ASSERT_NE(sss.bsdf.subsurface(), nullptr);
+    EXPECT_FLOAT_EQ(sss.bsdf.subsurface()->eta(), 1.5f);
+    bool specularTransmission = false;
+    for (int i = 0; i < sss.bsdf.numComponents(); ++i)
+        specularTransmission |= sss.bsdf.component(i).get<SpecularTransmission>() != nullptr;
+    EXPECT_TRUE(specularTransmission);
+    // thin: no BSSRDF.
+    MaterialHit thin = materialHit(
+        "Material \"disney\" \"color scatterdistance\" [0.2 0.3 0.4] \"bool thin\" true");
+    ASSERT_TRUE(thin.ok);
+    EXPECT_EQ(thin.bsdf.subsurface(), nullptr);
+    MaterialHit plain = materialHit("Material \"disney\"");
+    ASSERT_TRUE(plain.ok);
+    EXPECT_EQ(plain.bsdf.subsurface(), nullptr);
 }
 
 }  // namespace
