@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include "render/bxdfs.h"
 #include "render/fourier_bsdf.h"
@@ -103,6 +106,18 @@ void computeBeamDiffusionTable(float g, float eta, BSSRDFTable* t) {
         t->rhoEff[size_t(i)] =
             integrateCatmullRom(t->nRadius, t->radius.data(), row, &t->cdf[size_t(i * t->nRadius)]);
     }
+}
+
+std::shared_ptr<const BSSRDFTable> beamDiffusionTable(float g, float eta) {
+    static std::mutex mutex;
+    static std::map<std::pair<float, float>, std::weak_ptr<const BSSRDFTable>> cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto& slot = cache[{g, eta}];
+    if (auto t = slot.lock()) return t;
+    auto t = std::make_shared<BSSRDFTable>();
+    computeBeamDiffusionTable(g, eta, t.get());
+    slot = t;
+    return t;
 }
 
 namespace {

@@ -9,6 +9,7 @@
 // given, as pbrt-v3 does).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,9 @@ struct BSSRDFTable {
     float at(int iRho, int iRadius) const { return profile[size_t(iRho * nRadius + iRadius)]; }
 };
 void computeBeamDiffusionTable(float g, float eta, BSSRDFTable* t);
+// The table for (g, eta), computed once per process and shared (thread-safe): the materials
+// of a scene often share their parameters (0.07 s per table).
+std::shared_ptr<const BSSRDFTable> beamDiffusionTable(float g, float eta);
 
 // pbrt-v3's SubsurfaceFromDiffuse: per channel the albedo whose effective albedo is rhoEff
 // (inverting the table's rhoEff spline), with sigma_t = 1 / mfp.

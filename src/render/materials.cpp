@@ -259,9 +259,8 @@ public:
         bool remap = true;
     };
     SubsurfaceMaterial(Textures t, FTex bump)
-        : SurfaceMaterial(std::move(bump)), t_(std::move(t)) {
-        computeBeamDiffusionTable(t_.g, t_.eta, &table_);
-    }
+        : SurfaceMaterial(std::move(bump)), t_(std::move(t)),
+          table_(beamDiffusionTable(t_.g, t_.eta)) {}
     void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
         TextureContext tc = textureContext(si);
         initFrame(si, tc, bsdf, t_.eta);
@@ -272,17 +271,17 @@ public:
             const Spectrum mfp = t_.scale * t_.mfp->evaluate(tc);
             const Spectrum kd = glm::clamp(t_.reflectance->evaluate(tc), Spectrum(0.f),
                                            Spectrum(1.f));
-            subsurfaceFromDiffuse(table_, kd, mfp, &sa, &ss);
+            subsurfaceFromDiffuse(*table_, kd, mfp, &sa, &ss);
         } else {
             sa = t_.scale * clampZero(t_.sigmaA->evaluate(tc));
             ss = t_.scale * clampZero(t_.sigmaS->evaluate(tc));
         }
-        bsdf->setSubsurface(SeparableBSSRDF::tabulated(&table_, sa, ss, t_.eta));
+        bsdf->setSubsurface(SeparableBSSRDF::tabulated(table_.get(), sa, ss, t_.eta));
     }
 
 private:
     Textures t_;
-    BSSRDFTable table_;
+    std::shared_ptr<const BSSRDFTable> table_;  // shared by the materials of the same g, eta
 };
 
 // pbrt-v3's FourierMaterial: one tabulated lobe (none, a black surface, if the table could not
