@@ -15,6 +15,7 @@ void BSDF::init(const Vec3& ng, const Vec3& ns, const Vec3& tangent, float eta) 
     }
     eta_ = eta;
     n_ = 0;
+    hasSubsurface_ = false;
 }
 
 bool BSDF::add(const BxDF& bxdf) {
@@ -139,8 +140,13 @@ void buildDisney(BSDF& bsdf, const DisneyParams& p, TransportMode mode) {
             Spectrum rd = cd * (1.f - p.flatness) * (1.f - dt), rss = cd * p.flatness * (1.f - dt);
             addIf(DisneyDiffuseLobe(Kind::Diffuse, rd), rd);
             addIf(DisneyDiffuseLobe(Kind::FakeSS, rss, rough), rss);
-        } else {
+        } else if (isBlack(p.scatterDistance)) {
             addIf(DisneyDiffuseLobe(Kind::Diffuse, cd), cd);
+        } else {
+            // Subsurface scattering instead of the diffuse lobe: a smooth transmission of
+            // weight 1 into the BSSRDF (pbrt-v3).
+            bsdf.add(SpecularTransmission(Spectrum(1.f), 1.f, e, mode));
+            bsdf.setSubsurface(SeparableBSSRDF::disney(cd, p.scatterDistance, e));
         }
         addIf(DisneyDiffuseLobe(Kind::Retro, cd, rough), cd);
         if (p.sheen > 0.f) {

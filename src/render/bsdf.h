@@ -3,6 +3,7 @@
 // already-evaluated (texture-looked-up) parameter values.
 #pragma once
 
+#include "render/bssrdf.h"
 #include "render/bxdfs.h"
 #include "render/math.h"
 
@@ -30,8 +31,18 @@ class BSDF {
     // of the shading geometry) that is Gram-Schmidt-orthogonalised against ns (an arbitrary
     // tangent is used if it is degenerate). Removes all lobes; sets the relative IOR eta.
     void init(const Vec3& ng, const Vec3& ns, const Vec3& tangent, float eta = 1.f);
-    // Removes all lobes (frame and eta are kept).
-    void clear() { n_ = 0; }
+    // Removes all lobes and the BSSRDF (frame and eta are kept).
+    void clear() {
+        n_ = 0;
+        hasSubsurface_ = false;
+    }
+    // The material's BSSRDF (pbrt-v3's si->bssrdf: subsurface, kdsubsurface, disney with a
+    // scatter distance), or null. The integrator follows it after sampling a transmission.
+    const SeparableBSSRDF* subsurface() const { return hasSubsurface_ ? &bssrdf_ : nullptr; }
+    void setSubsurface(const SeparableBSSRDF& b) {
+        bssrdf_ = b;
+        hasSubsurface_ = true;
+    }
     // Appends a lobe; returns false (and ignores it) if MaxBxDFs lobes are already present.
     bool add(const BxDF& bxdf);
 
@@ -104,6 +115,8 @@ class BSDF {
     Vec3 ng_{0.f, 0.f, 1.f};
     float eta_ = 1.f;
     int n_ = 0;
+    bool hasSubsurface_ = false;
+    SeparableBSSRDF bssrdf_;
     BxDFFlags flags_[MaxBxDFs];  // each lobe's flags, taken at add() (queried per vertex)
     BxDF bxdfs_[MaxBxDFs];
 };
@@ -142,6 +155,9 @@ void buildTranslucent(BSDF& bsdf, Spectrum kd, Spectrum ks, Spectrum reflect,
                       Spectrum transmit, float roughness, bool remap,
                       TransportMode mode = TransportMode::Radiance);
 
+// subsurface / kdsubsurface (pbrt-v3): the boundary is buildGlass(kr, kt, eta, u, v, remap);
+// the BSSRDF is set by the material.
+
 // disney (pbrt-v3's DisneyMaterial, Burley 2012/2015), from evaluated parameters; names and
 // defaults are pbrt-v3's. With diffuse weight dw = (1 - metallic)(1 - spectrans) > 0:
 // DisneyDiffuse(dw c) (thin: DisneyDiffuse(dw (1 - flatness)(1 - difftrans / 2) c) +
@@ -149,13 +165,14 @@ void buildTranslucent(BSDF& bsdf, Spectrum kd, Spectrum ks, Spectrum reflect,
 // tint)) if sheen > 0; then MicrofacetReflection(1, TR, DisneyFresnel) +
 // DisneyClearcoat if clearcoat > 0 + MicrofacetTransmission(spectrans sqrt(c)) if spectrans > 0
 // (thin: with roughness scaled by 0.65 eta - 0.35) + thin: LambertianTransmission(difftrans / 2
-// c). A non-black scatterdistance (pbrt-v3's BSSRDF, not thin) is rendered with DisneyDiffuse
-// (the caller warns). BSDF eta 1, as pbrt-v3's.
+// c). Not thin with a non-black scatterdistance: SpecularTransmission(1, 1, eta) and Disney's
+// BSSRDF (dw c, scatterdistance) replace DisneyDiffuse (pbrt-v3). BSDF eta 1, as pbrt-v3's.
 struct DisneyParams {
     Spectrum color{0.5f};
     float metallic = 0.f, eta = 1.5f, roughness = 0.5f, specularTint = 0.f, anisotropic = 0.f;
     float sheen = 0.f, sheenTint = 0.5f, clearcoat = 0.f, clearcoatGloss = 1.f;
     float specTrans = 0.f, flatness = 0.f, diffTrans = 1.f;
+    Spectrum scatterDistance{0.f};
     bool thin = false;
 };
 void buildDisney(BSDF& bsdf, const DisneyParams& p, TransportMode mode = TransportMode::Radiance);

@@ -1,5 +1,6 @@
 #include "render/bxdfs.h"
 
+#include "render/bssrdf.h"
 #include "render/sampling.h"
 
 namespace rlpbrt {
@@ -121,6 +122,24 @@ BxDFSample LambertianReflection::sampleF(const Vec3& wo, float, Vec2 u) const {
 }
 
 float LambertianReflection::pdf(const Vec3& wo, const Vec3& wi) const {
+    return sameHemisphere(wo, wi) ? absCosTheta(wi) * InvPi : 0.f;
+}
+
+BSSRDFExitLobe::BSSRDFExitLobe(float eta, TransportMode mode)
+    : eta(eta), c(1.f - 2.f * fresnelMoment1(1.f / eta)), mode(mode) {}
+
+Spectrum BSSRDFExitLobe::f(const Vec3& wo, const Vec3& wi) const {
+    if (!sameHemisphere(wo, wi)) return Spectrum(0.f);
+    float v = (1.f - frDielectric(cosTheta(wi), 1.f, eta)) / (c * Pi);
+    if (mode == TransportMode::Radiance) v *= eta * eta;
+    return Spectrum(v);
+}
+
+BxDFSample BSSRDFExitLobe::sampleF(const Vec3& wo, float, Vec2 u) const {
+    return sampleCosineReflection(*this, wo, u);
+}
+
+float BSSRDFExitLobe::pdf(const Vec3& wo, const Vec3& wi) const {
     return sameHemisphere(wo, wi) ? absCosTheta(wi) * InvPi : 0.f;
 }
 

@@ -293,6 +293,20 @@ struct HairBxDF {
     }
 };
 
+// The exit lobe of a separable BSSRDF (pbrt-v3's SeparableBSSRDFAdapter, bssrdf.h): Sw(wi) =
+// (1 - Fr(cos wi; 1, eta)) / (c pi), c = 1 - 2 FresnelMoment1(1 / eta), times eta^2 for
+// radiance transport. Reflection | diffuse, sampled cosine-weighted on wo's side (the path
+// leaves the exit point with wo = the shading normal).
+struct BSSRDFExitLobe {
+    float eta, c;
+    TransportMode mode;
+    BSSRDFExitLobe(float eta, TransportMode mode);
+    Spectrum f(const Vec3& wo, const Vec3& wi) const;
+    BxDFSample sampleF(const Vec3& wo, float uc, Vec2 u) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    BxDFFlags flags() const { return BxDFFlags::Reflection | BxDFFlags::Diffuse; }
+};
+
 // Any one lobe, stored by value.
 class BxDF {
   public:
@@ -300,7 +314,8 @@ class BxDF {
         std::variant<LambertianReflection, LambertianTransmission, OrenNayar,
                      SpecularReflection, SpecularTransmission, FresnelSpecular,
                      MicrofacetReflection, MicrofacetTransmission, FresnelBlend,
-                     DisneyDiffuseLobe, DisneyClearcoat, FourierBSDF, HairBxDF>;
+                     DisneyDiffuseLobe, DisneyClearcoat, FourierBSDF, HairBxDF,
+                     BSSRDFExitLobe>;
 
     // A black Lambertian reflection lobe.
     BxDF() = default;

@@ -356,6 +356,68 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     return Step::Scattered;
 }
 
+PathIntegrator::Step PathIntegrator::subsurfaceStep(PathState& s, const SurfaceInteraction& si,
+                                                    const BSDF& bsdf, Sampler& sampler,
+                                                    PathStats& stats, PathRecorder& rec) const {
+    const SeparableBSSRDF& b = *bsdf.subsurface();
+    const float u1 = sampler.get1D();
+    const Vec2 u2 = sampler.get2D();
+    BSSRDFProbe probe;
+    if (!sampleProbe(b, bsdf.frame(), si.p, u1, u2, &probe)) return Step::End;
+    // Every hit of the probe segment on a surface of the entry's material (pbrt-v3 keeps all;
+    // more than kMaxHits on one segment is not expected, the rest are not counted).
+    constexpr int kMaxHits = 16;
+    SurfaceInteraction hits[kMaxHits];
+    int found = 0;
+    Vec3 o = probe.start;
+    const Vec3 seg = probe.end - probe.start;
+    const float len = glm::length(seg);
+    if (!(len > 0.f)) return Step::End;
+    const Vec3 d = seg / len;
+    for (int crossings = 0; crossings < 256 && found < kMaxHits; ++crossings) {
+        const float remaining = glm::dot(probe.end - o, d);
+        if (!(remaining > 0.f)) break;
+        ++stats.rays;
+        SurfaceInteraction& h = hits[found];
+        if (!scene_.intersect(Ray(o, d, remaining), &h)) break;
+        o = spawnOrigin(h, d, originScale_);
+        if (h.material == si.material) ++found;
+    }
+    if (found == 0) return Step::End;
+    const int pick = std::min(int(probe.uPick * float(found)), found - 1);
+    SurfaceInteraction pi = hits[pick];
+    const float pdf = pdfSp(b, bsdf.frame(), si.p, pi.p, pi.ng) / float(found);
+    const Spectrum sp = b.sr(glm::distance(si.p, pi.p));
+    if (!(pdf > 0.f) || isBlack(sp)) return Step::End;
+    s.beta *= sp / pdf;
+    if (!isFinite(s.beta)) return Step::End;
+    rec.subsurfaceScattered();
+
+    // The exit vertex: the exit lobe Sw in the frame of the hit (no material evaluation, as
+    // pbrt-v3), seen from its shading normal. Not guided: the lobe is BSDF-sampled.
+    BSDF exit;
+    exit.init(pi.ng, pi.ns, glm::length(pi.shadingTangent) > 0.f ? pi.shadingTangent : pi.dpdu);
+    exit.add(BSSRDFExitLobe(b.eta(), TransportMode::Radiance));
+    pi.wo = pi.ns;
+    const bool media = scene_.hasMedia();
+    ++stats.vertices;
+    GuideMixture none{guiding::VertexGuide(), 0.f};
+    s.L += s.beta * sampleLight(pi, exit, none, sampler, stats, media ? &s.pm : nullptr);
+    const float uc = sampler.get1D();
+    const Vec2 u = sampler.get2D();
+    const BSDFSample bs = exit.sampleF(pi.wo, uc, u);
+    if (!bs.valid() || isBlack(bs.f)) return Step::End;
+    s.beta *= bs.f * (std::abs(glm::dot(bs.wi, pi.ns)) / bs.pdf);
+    s.dirPdf = bs.pdf;
+    s.specularBounce = false;
+    s.prev = LightSampleContext{pi.p, pi.ng};
+    if (media) s.pm.medium = pi.mediumAfter(bs.wi, s.pm.medium);
+    s.ray.o = spawnOrigin(pi, bs.wi, originScale_);
+    s.ray.d = bs.wi;
+    s.ray.tMax = Infinity;
+    return isFinite(s.beta) ? Step::Scattered : Step::End;
+}
+
 Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& stats,
                             int slot, float pixelEstimate) const {
     PathState s;
@@ -508,6 +570,10 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         s.ray.d = ds.wi;
         s.ray.tMax = Infinity;
         if (!isFinite(s.beta)) break;
+        // A transmission into a material with a BSSRDF: the path continues from an exit point.
+        if (ds.transmission && bsdf.subsurface() &&
+            subsurfaceStep(s, si, bsdf, sampler, stats, rec) == Step::End)
+            break;
 
         // Russian roulette: from the second vertex on, on the expected contribution where
         // the guide knows it; else pbrt-v3's.

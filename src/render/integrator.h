@@ -196,6 +196,13 @@ private:
     enum class Step { Surface, Scattered, End };
     Step mediumStep(PathState& s, bool found, const SurfaceInteraction& si, int bounces,
                     Sampler& sampler, PathStats& stats, PathRecorder& rec) const;
+    // The subsurface step of Li (pbrt-v3's BSSRDF sampling), after the BSDF of a material with
+    // a BSSRDF sampled a transmission at si: a probe segment (bssrdf.h) is intersected with the
+    // surfaces of si's material, one hit is the exit point; the throughput takes Sp / pdf,
+    // next-event estimation runs there with the exit lobe, and s.ray leaves the exit in a
+    // direction sampled from that lobe. Scattered: s.ray is the next ray; End: the path ends.
+    Step subsurfaceStep(PathState& s, const SurfaceInteraction& si, const BSDF& bsdf,
+                        Sampler& sampler, PathStats& stats, PathRecorder& rec) const;
 
     const Scene& scene_;
     std::unique_ptr<LightSampler> lights_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "render/bssrdf.h"
 #include "render/fourier_bsdf.h"
 #include "render/hair.h"
 
@@ -236,11 +237,51 @@ public:
         p.thin = t_.thin;
         if (p.thin) p.flatness = t_.flatness->evaluate(tc);
         p.diffTrans = t_.diffTrans->evaluate(tc);
+        if (!p.thin) p.scatterDistance = clampZero(t_.scatterDistance->evaluate(tc));
         buildDisney(*bsdf, p);
     }
 
 private:
     Textures t_;
+};
+
+// pbrt-v3's SubsurfaceMaterial and KdSubsurfaceMaterial: a dielectric boundary (smooth or
+// rough, as glass) over a TabulatedBSSRDF of the photon beam diffusion table for (g, eta).
+// Coefficients: sigma_a and sigma_s textures (subsurface), or a diffuse reflectance and mean
+// free path inverted with the table (kdsubsurface; subsurface with "reflectance"); times
+// scale.
+class SubsurfaceMaterial : public SurfaceMaterial {
+public:
+    struct Textures {
+        STex kr, kt, sigmaA, sigmaS, reflectance, mfp;  // reflectance set: the Kd/mfp form
+        FTex u, v;
+        float scale = 1.f, eta = 1.33f, g = 0.f;
+        bool remap = true;
+    };
+    SubsurfaceMaterial(Textures t, FTex bump)
+        : SurfaceMaterial(std::move(bump)), t_(std::move(t)),
+          table_(beamDiffusionTable(t_.g, t_.eta)) {}
+    void computeBSDF(const SurfaceInteraction& si, float, BSDF* bsdf) const override {
+        TextureContext tc = textureContext(si);
+        initFrame(si, tc, bsdf, t_.eta);
+        buildGlass(*bsdf, clampZero(t_.kr->evaluate(tc)), clampZero(t_.kt->evaluate(tc)), t_.eta,
+                   t_.u->evaluate(tc), t_.v->evaluate(tc), t_.remap);
+        Spectrum sa, ss;
+        if (t_.reflectance) {
+            const Spectrum mfp = t_.scale * t_.mfp->evaluate(tc);
+            const Spectrum kd = glm::clamp(t_.reflectance->evaluate(tc), Spectrum(0.f),
+                                           Spectrum(1.f));
+            subsurfaceFromDiffuse(*table_, kd, mfp, &sa, &ss);
+        } else {
+            sa = t_.scale * clampZero(t_.sigmaA->evaluate(tc));
+            ss = t_.scale * clampZero(t_.sigmaS->evaluate(tc));
+        }
+        bsdf->setSubsurface(SeparableBSSRDF::tabulated(table_.get(), sa, ss, t_.eta));
+    }
+
+private:
+    Textures t_;
+    std::shared_ptr<const BSSRDFTable> table_;  // shared by the materials of the same g, eta
 };
 
 // pbrt-v3's FourierMaterial: one tabulated lobe (none, a black surface, if the table could not
@@ -380,13 +421,6 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
         dt.thin = p.getBool("thin", false);
         dt.flatness = tex.floatTex(p, "flatness", 0.f);
         dt.diffTrans = tex.floatTex(p, "difftrans", 1.f);
-        auto* sd = dynamic_cast<const ConstantSpectrumTexture*>(dt.scatterDistance.get());
-        if (!dt.thin && !(sd && isBlack(sd->value()))) {
-            const Param* sp = p.find("scatterdistance");
-            diag.ignored(sp ? sp->loc : e.loc,
-                         "disney material: \"scatterdistance\" (pbrt-v3's subsurface "
-                         "scattering) is not supported yet; its diffuse lobe is used instead");
-        }
         m = std::make_unique<DisneyMaterial>(std::move(dt), bump);
     } else if (t == "fourier") {
         auto table = std::make_shared<FourierTable>();
@@ -404,11 +438,49 @@ std::unique_ptr<Material> createMaterial(const MaterialEntity& e, TextureResolve
     } else if (t == "hair") {
         m = createHairMaterial(e, tex, diag);
     } else if (t == "subsurface" || t == "kdsubsurface") {
-        p.markAllUsed();
-        diag.ignored(e.loc, "material \"" + t + "\" is not supported; rendered as matte "
-                            "(Kd 0.5) instead");
-        m = std::make_unique<MatteMaterial>(std::make_shared<ConstantSpectrumTexture>(Spectrum(0.5f)),
-                                            std::make_shared<ConstantFloatTexture>(0.f), nullptr);
+        SubsurfaceMaterial::Textures st;
+        st.kr = tex.spectrumTex(p, "Kr", Spectrum(1.f));
+        st.kt = tex.spectrumTex(p, "Kt", Spectrum(1.f));
+        st.u = tex.floatTex(p, "uroughness", 0.f);
+        st.v = tex.floatTex(p, "vroughness", 0.f);
+        st.remap = remap;
+        st.eta = p.getFloat("eta", 1.33f);
+        st.scale = p.getFloat("scale", 1.f);
+        st.g = p.getFloat("g", 0.f);
+        if (t == "kdsubsurface") {
+            st.reflectance = tex.spectrumTex(p, "Kd", Spectrum(0.5f));
+            st.mfp = tex.spectrumTex(p, "mfp", Spectrum(1.f));
+        } else {
+            // pbrt-v3's defaults: whole milk (mm^-1); a named measured medium replaces them
+            // and forces g = 0 (the table holds reduced scattering coefficients).
+            Spectrum sa(0.0011f, 0.0024f, 0.014f), ss(2.55f, 3.21f, 3.77f);
+            const std::string name = p.getString("name", "");
+            if (!name.empty()) {
+                if (measuredSubsurface(name, &sa, &ss)) {
+                    st.g = 0.f;
+                } else {
+                    const Param* np = p.find("name");
+                    diag.substituted(np ? np->loc : e.loc,
+                                     "subsurface material: unknown measured medium \"" + name +
+                                         "\"; pbrt-v3's defaults (whole milk) are used");
+                }
+            }
+            if (p.has("reflectance")) {
+                // The reflectance / mean free path form (as kdsubsurface).
+                st.reflectance = tex.spectrumTex(p, "reflectance", Spectrum(1.f));
+                st.mfp = tex.spectrumTex(p, "mfp", Spectrum(1.f));
+            } else {
+                st.sigmaA = tex.spectrumTex(p, "sigma_a", sa);
+                st.sigmaS = tex.spectrumTex(p, "sigma_s", ss);
+            }
+        }
+        if (!(st.eta > 0.f)) {
+            const Param* ep = p.find("eta");
+            diag.error(ep ? ep->loc : e.loc, t + " material: \"eta\" must be positive");
+            *ok = false;
+            return nullptr;
+        }
+        m = std::make_unique<SubsurfaceMaterial>(std::move(st), bump);
     } else {
         // pbrt-v3 warns and makes a matte material from the same parameters.
         diag.substituted(e.loc, "unknown material type \"" + t +

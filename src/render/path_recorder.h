@@ -98,6 +98,12 @@ public:
             pending_ = PendingRecord();
         }
     }
+    // The path jumped through a BSSRDF from its entry to an exit point: the pending Eq. 1
+    // record is dropped (no one direction connects its vertex to what follows the exit; the
+    // exit's light is a subsurface transport, not a radiance along the recorded direction).
+    // Returns stay valid: the light gathered after a vertex is still what its direction
+    // brought back.
+    void subsurfaceScattered() { pending_ = PendingRecord(); }
     // The path ended with radiance L: records the returns and the selection samples.
     void finish(const Spectrum& L);
 

@@ -476,6 +476,15 @@ public:
             }
             return spectrum_[size_t(it->second)];
         }
+        if (p->type == ParamType::Float) {
+            // pbrt-v3 looks a spectrum parameter up among the spectra only: a float of the
+            // same name is left unused (a warning) and the default applies.
+            p->used = true;
+            diag_.substituted(p->loc, "parameter \"float " + name +
+                                          "\" where a spectrum is expected is ignored; the "
+                                          "default is used (as pbrt-v3)");
+            return std::make_shared<ConstantSpectrumTexture>(def);
+        }
         const Param* s = params.getSpectral(name);
         if (!s) return std::make_shared<ConstantSpectrumTexture>(def);
         return std::make_shared<ConstantSpectrumTexture>(spectrumFromParam(*s));

@@ -162,19 +162,16 @@ TEST_P(MediaReferenceTest, MatchesPbrtV3At64spp) {
     checkAgainstPbrtV3(std::get<0>(GetParam()), std::get<1>(GetParam()), true);
 }
 
-// The feature scenes (references/features/). disney.small.pbrt's third sphere (columns < 70)
-// has a "scatterdistance": pbrt-v3 renders it with its BSSRDF, which rlpbrt does not have yet
-// (a diffuse lobe stands in, with a warning), so the test compares the two other spheres and
-// the floor, columns 70..199 (rendered alone through a crop window). pbrt-v3's own 64-spp
-// figure is for the whole image, whose noisiest part (the BSSRDF sphere) is left out here:
-// the crop is held to 1.0x that figure instead of 1.5x. (Drop the crop when subsurface
-// scattering is supported.)
+// The feature scenes (references/features/), whole images. (Region can restrict a scene to
+// columns x0.. through a crop window, with its own bound factor.)
 struct FeatureScene {
     const char* id;
     Region region;
 };
 const FeatureScene kFeatureScenes[] = {
-    {"pbrt-features__disney", {70, 1.0}},
+    {"pbrt-features__disney", {}},        // its third sphere has a BSSRDF (scatterdistance)
+    {"pbrt-features__subsurface", {}},    // named measured media (f11-15)
+    {"pbrt-features__kdsubsurface", {}},  // Kd + mfp, smooth and rough boundaries
     {"pbrt-features__nurbs", {}},
     {"pbrt-features__curves", {}},  // flat, cylinder and ribbon curves
     {"pbrt-features__hair", {}},    // hair on cylinder curves (sigma_a and pigments)
