@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "render/bssrdf.h"
 #include "render/sampling.h"
 #include "render/spectrum.h"
 #include "render/transform.h"
@@ -175,14 +176,15 @@ GridMedium::GridMedium(const Spectrum& sigmaA, const Spectrum& sigmaS, float g,
 
 std::unique_ptr<Medium> createMedium(const MediumEntity& e, Diagnostics& diag) {
     const ParamList& ps = e.params;
-    // pbrt-v3's defaults (its "preset" table of measured media is not included: a preset
-    // name falls back to these values with a warning, as pbrt-v3 does for unknown names).
+    // pbrt-v3's defaults, or a "preset" from its table of measured media (the subsurface
+    // materials' table: sigma_a and the reduced sigma'_s, taken as sigma_s as pbrt-v3 does);
+    // an unknown name keeps the defaults with a warning, as pbrt-v3.
     Spectrum sigA(.0011f, .0024f, .014f), sigS(2.55f, 3.21f, 3.77f);
     std::string preset = ps.getString("preset", "");
-    if (!preset.empty())
+    if (!preset.empty() && !measuredSubsurface(preset, &sigA, &sigS))
         diag.substituted(ps.find("preset")->loc, "medium preset \"" + preset +
-                                                 "\" is not available in rlpbrt; using the "
-                                                 "default sigma_a and sigma_s");
+                                                 "\" is not a measured medium pbrt-v3 knows; "
+                                                 "using the default sigma_a and sigma_s");
     float scale = ps.getFloat("scale", 1.f);
     float g = ps.getFloat("g", 0.f);
     if (const Param* p = ps.getSpectral("sigma_a")) sigA = spectrumFromParam(*p);

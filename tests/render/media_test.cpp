@@ -318,6 +318,45 @@ WorldEnd
     EXPECT_EQ(si.mediumAfter(Vec3(0, 0, -1), 1), 1);
 }
 
+// "preset" names pbrt-v3's measured media (Ketchup: sigma_a (0.061, 0.97, 1.45), sigma'_s
+// (0.18, 0.07, 0.03) per mm); sigma_a, sigma_s and scale apply on top, as in pbrt-v3; an
+// unknown name keeps the defaults with a located warning.
+TEST(MediaScene, PresetsAreMeasuredMedia) {
+    std::string path = writeTemp("rlpbrt_media_preset.pbrt", R"(
+Integrator "volpath"
+MakeNamedMedium "ketchup" "string type" "homogeneous" "string preset" "Ketchup"
+  "float scale" 2
+MakeNamedMedium "odd" "string type" "homogeneous" "string preset" "Gravy"
+WorldBegin
+LightSource "point" "rgb I" [1 1 1]
+AttributeBegin
+  MediumInterface "ketchup" ""
+  Material ""
+  Shape "sphere"
+AttributeEnd
+MediumInterface "odd" ""
+Material ""
+Shape "sphere" "float radius" 2
+WorldEnd
+)");
+    Diagnostics diag;
+    std::ostringstream out;
+    diag.setStream(&out);
+    std::unique_ptr<Scene> scene = buildFrom(path, diag);
+    ASSERT_NE(scene, nullptr);
+    EXPECT_EQ(diag.errorCount(), 0);
+    ASSERT_EQ(scene->media.size(), 2u);
+    Rng rng(1);
+    // Blue: sigma_t = 2 x (1.45 + 0.03) over a unit distance.
+    EXPECT_NEAR(scene->media[0]->tr(Vec3(0.f), Vec3(1, 0, 0), 1.f, rng)[2],
+                std::exp(-2.f * 1.48f), 1e-5);
+    // The defaults: sigma_t (2.5511, 3.2124, 3.784) in red, green, blue.
+    EXPECT_NEAR(scene->media[1]->tr(Vec3(0.f), Vec3(1, 0, 0), 1.f, rng)[0],
+                std::exp(-(0.0011f + 2.55f)), 1e-5);
+    EXPECT_NE(out.str().find("rlpbrt_media_preset.pbrt:5:"), std::string::npos) << out.str();
+    EXPECT_NE(out.str().find("Gravy"), std::string::npos) << out.str();
+}
+
 TEST(MediaScene, PathIntegratorIgnoresMediaAsPbrtV3) {
     std::string path = writeTemp("rlpbrt_media_path.pbrt", R"(
 MakeNamedMedium "fog" "string type" "homogeneous"
