@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cstdlib>
 #include <vector>
@@ -28,6 +29,19 @@ void orderedSum(void* in, void* inout, int* len, MPI_Datatype*) {
     for (int i = 0; i < *len; ++i) b[i] = a[i] + b[i];
 }
 
+double now() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+// Adds the wall time of a scope to a counter.
+struct Timed {
+    explicit Timed(double* total) : total_(total), start_(now()) {}
+    ~Timed() { *total_ += now() - start_; }
+    double* total_;
+    double start_;
+};
+
 // Counts above INT_MAX go in chunks.
 constexpr size_t kChunk = size_t(1) << 28;
 
@@ -43,6 +57,7 @@ public:
     int size() const override { return size_; }
 
     void sumDoubles(double* data, size_t n) override {
+        Timed t(&seconds_);
         bytes_ += n * sizeof(double);
         std::vector<double> out(rank_ == 0 ? std::min(n, kChunk) : 0);
         for (size_t off = 0; off < n; off += kChunk) {
@@ -56,6 +71,7 @@ public:
     }
 
     void sumDisjointFloats(float* data, size_t n, bool everyone) override {
+        Timed t(&seconds_);
         bytes_ += n * sizeof(float);
         for (size_t off = 0; off < n; off += kChunk) {
             const int c = int(std::min(kChunk, n - off));
@@ -68,6 +84,7 @@ public:
     }
 
     void broadcast(void* data, size_t bytes) override {
+        Timed t(&seconds_);
         bytes_ += bytes;
         char* p = static_cast<char*>(data);
         for (size_t off = 0; off < bytes; off += kChunk)
@@ -75,6 +92,7 @@ public:
     }
 
     bool allOk(bool ok) override {
+        Timed t(&seconds_);
         int v = ok ? 1 : 0, all = 0;
         bytes_ += sizeof(int);
         MPI_Allreduce(&v, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
@@ -82,11 +100,13 @@ public:
     }
 
     uint64_t bytesExchanged() const override { return bytes_; }
+    double secondsExchanging() const override { return seconds_; }
 
 private:
     int rank_ = 0, size_ = 1;
     MPI_Op sumOp_;
     uint64_t bytes_ = 0;
+    double seconds_ = 0.0;
 };
 
 }  // namespace

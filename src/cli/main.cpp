@@ -379,6 +379,9 @@ int main(int argc, char** argv) {
         j["passes"] = r.passes;
         j["bytes_exchanged"] = r.bytesExchanged;
         j["bytes_exchanged_per_pass"] = r.passes ? double(r.bytesExchanged) / r.passes : 0.0;
+        // Rank 0's wall seconds in the collectives during the render (waiting for slower
+        // ranks included).
+        j["exchange_seconds"] = r.secondsExchanging;
         std::ofstream f(statsFile);
         f << j.dump(2) << "\n";
         if (!f) {

@@ -33,6 +33,9 @@ public:
 
     // Bytes this rank has sent into collectives so far (its buffers' sizes, the payload).
     virtual uint64_t bytesExchanged() const = 0;
+    // Wall seconds this rank has spent in collectives (transfers, and waiting for slower
+    // ranks).
+    virtual double secondsExchanging() const = 0;
 };
 
 // Whether tile `index` of a pass is this rank's (null ranks: a single process renders all).

@@ -158,6 +158,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // integrator reads the image so far (the pixel estimates), else rank 0 alone.
     const bool everyoneNeedsFilm = field && integrator.wantsPixelEstimate();
     std::vector<float> exchange;
+    const double exchangeBefore = ranks ? ranks->secondsExchanging() : 0.0;
     if (ranks) {
         size_t n = 0;
         for (const auto& t : tileFilms) n += t->floatCount();
@@ -354,6 +355,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
         result.ranks = ranks->size();
         result.bytesExchanged = ranks->bytesExchanged();
+        result.secondsExchanging = ranks->secondsExchanging() - exchangeBefore;
     }
     result.image = film.toImage();
     return result;

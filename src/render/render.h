@@ -49,6 +49,7 @@ struct RenderResult {
     int ranks = 1;                // processes that rendered (RenderOptions::ranks)
     int passes = 0;
     uint64_t bytesExchanged = 0;  // this rank's payload in the ranks' collectives
+    double secondsExchanging = 0.0;  // ... and its wall time in them (during the render)
 };
 
 RenderResult render(const Scene& scene, const RenderOptions& options);
