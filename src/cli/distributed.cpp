@@ -78,8 +78,9 @@ public:
             if (everyone)
                 MPI_Allreduce(MPI_IN_PLACE, data + off, c, MPI_FLOAT, MPI_SUM, MPI_COMM_WORLD);
             else
-                MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : data + off, rank_ == 0 ? data + off : nullptr,
-                           c, MPI_FLOAT, MPI_SUM, 0, MPI_COMM_WORLD);
+                MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : data + off,
+                           rank_ == 0 ? data + off : nullptr, c, MPI_FLOAT, MPI_SUM, 0,
+                           MPI_COMM_WORLD);
         }
     }
 

@@ -132,7 +132,8 @@ void checkShared(const char* backend, const SceneInfo& scene,
     constexpr int kRanks = 3, kPasses = 3;
     auto one = test::makeField<Field>(backend, scene, params);
     std::vector<std::unique_ptr<Field>> ranks;
-    for (int k = 0; k < kRanks; ++k) ranks.push_back(test::makeField<Field>(backend, scene, params));
+    for (int k = 0; k < kRanks; ++k)
+        ranks.push_back(test::makeField<Field>(backend, scene, params));
     ASSERT_TRUE(one);
     ThreadSum sum(kRanks);
     for (int pass = 0; pass < kPasses; ++pass) {
