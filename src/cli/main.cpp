@@ -292,6 +292,12 @@ int main(int argc, char** argv) {
                                  "yet (docs/DISTRIBUTED.md)\n");
             return fail();
         }
+        if (field && !field->sharesPasses()) {
+            std::fprintf(stderr, "error: this guide (%s) cannot be learned by several ranks "
+                                 "yet (directions=tree; docs/DISTRIBUTED.md)\n",
+                         guide.c_str());
+            return fail();
+        }
         if (!ranks->allOk(true)) {
             std::fprintf(stderr, "rlpbrt: another rank failed before rendering; nothing "
                                  "rendered\n");

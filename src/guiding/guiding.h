@@ -211,6 +211,9 @@ public:
     // would differ only by the order of floating-point sums. The default applies this
     // process's records only (endPass()).
     virtual void endPassShared(const SumAcrossProcesses& sum);
+    // Whether endPassShared shares everything the field learns (false: the processes' fields
+    // would drift apart, so a distributed render refuses the field). Default: false.
+    virtual bool sharesPasses() const;
 
     // ---- Reporting and saving.
     // Memory of the learned data in bytes (tables, CDFs, points, kd-tree; not the per-pass

@@ -130,6 +130,8 @@ public:
                 int bin = -1) override;
     void endPass() override;
     void endPassShared(const SumAcrossProcesses& sum) override;
+    // Not with directions=tree: its adaptive trees are not shared yet.
+    bool sharesPasses() const override { return !trees_; }
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;

@@ -90,6 +90,7 @@ public:
                 int bin = -1) override;
     void endPass() override;
     void endPassShared(const SumAcrossProcesses& sum) override;
+    bool sharesPasses() const override { return true; }
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;
