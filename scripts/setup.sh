@@ -8,6 +8,7 @@ build=${1:-$here/build}
 pkgs=(build-essential cmake ninja-build pkg-config
       libembree-dev libopenimageio-dev libopenexr-dev libimath-dev libopenvdb-dev libglm-dev libtbb-dev
       libboost-iostreams-dev openimageio-tools libopencv-core-dev
+      openmpi-bin libopenmpi-dev  # distributed renders: docs/DISTRIBUTED.md
       libcli11-dev libfmt-dev nlohmann-json3-dev libnanoflann-dev libgtest-dev libgmock-dev libbenchmark-dev
       clang llvm libclang-rt-14-dev)  # clang + libFuzzer runtime: scripts/fuzz.sh
 missing=()

@@ -10,7 +10,9 @@
 #include <iostream>
 #include <thread>
 #include <unistd.h>
+#include <cstdlib>
 
+#include "cli/distributed.h"
 #include "guiding/options.h"
 #include "parser/diagnostics.h"
 #include "rlpbrt_commit.h"  // generated at build time: RLPBRT_COMMIT
@@ -64,6 +66,22 @@ std::string defaultOutput(const Scene& scene) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Under mpirun/srun: one rank of a distributed render (docs/DISTRIBUTED.md). Every rank
+    // reads the scene and prepares alike; rank 0 alone prints and writes, the others are
+    // quiet (their messages would repeat rank 0's).
+    DistributedSession session(&argc, &argv);
+    Ranks* const ranks = session.ranks();
+    const bool root = !ranks || ranks->rank() == 0;
+    if (session.launched() && !root) {
+        if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr))
+            session.abort(1);
+    }
+    // An error before rendering: every rank stops (the ranks that did not fail learn it in
+    // the agreement before the render).
+    auto fail = [&] {
+        if (ranks) ranks->allOk(false);
+        return 1;
+    };
     CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
     std::string scenePath, outFile, statsFile, guide = "hemi", curveFile, refFile;
     std::string guideSave, guideLoad;
@@ -143,7 +161,7 @@ int main(int argc, char** argv) {
     double parseSec = seconds() - t0;
     if (!ok) {
         std::fprintf(stderr, "rlpbrt: %d error(s); nothing rendered\n", diag.errorCount());
-        return 1;
+        return fail();
     }
     BuildOptions bo;
     bo.sppOverride = spp;
@@ -155,12 +173,12 @@ int main(int argc, char** argv) {
         scene = buildScene(desc, bo, diag);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "%s: error: %s\n", scenePath.c_str(), e.what());
-        return 1;
+        return fail();
     }
     double buildSec = seconds() - t1;
     if (!scene || diag.errorCount() > 0) {
         std::fprintf(stderr, "rlpbrt: %d error(s); nothing rendered\n", diag.errorCount());
-        return 1;
+        return fail();
     }
     if (parseOnly) {
         printSummary(desc, *scene, diag, parseSec, buildSec);
@@ -174,7 +192,7 @@ int main(int argc, char** argv) {
         auto eq = kv.find('=');
         if (eq == std::string::npos || eq == 0) {
             std::fprintf(stderr, "error: --guide-param expects key=value, got \"%s\"\n", kv.c_str());
-            return 1;
+            return fail();
         }
         gc.params[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
@@ -187,15 +205,15 @@ int main(int argc, char** argv) {
         double tg = seconds();
         if (!setupGuiding(*scene, gc, &field, &guideSettings, &gerr)) {
             std::fprintf(stderr, "error: --guide=%s: %s\n", guide.c_str(), gerr.c_str());
-            return 1;
+            return fail();
         }
         if (!field && (!guideLoad.empty() || !guideSave.empty())) {
             std::fprintf(stderr, "error: --guide-load/--guide-save need a guiding backend\n");
-            return 1;
+            return fail();
         }
         if (!guideLoad.empty() && !field->load(guideLoad, &gerr)) {
             std::fprintf(stderr, "error: --guide-load: %s\n", gerr.c_str());
-            return 1;
+            return fail();
         }
         if (field && !quiet)
             std::fprintf(stderr, "guide: %s (%.2f s to build)\n", field->describe().c_str(),
@@ -207,11 +225,11 @@ int main(int argc, char** argv) {
     const float mix = guideSettings.mix;
 
     if (outFile.empty()) outFile = defaultOutput(*scene);
-    {
+    if (root) {
         std::string err;  // no render for an output that cannot be written
         if (!checkOutputPath(outFile, &err)) {
             std::fprintf(stderr, "%s: error: %s\n", outFile.c_str(), err.c_str());
-            return 1;
+            return fail();
         }
     }
     RenderOptions ro;
@@ -222,11 +240,11 @@ int main(int argc, char** argv) {
     std::vector<std::string> curveRows;
     double curveCost = 0.0;
     int lastCurveSpp = 0;
-    if (!curveFile.empty()) {
+    if (!curveFile.empty() && root) {
         std::string rerr;
         if (!readImage(refFile, &reference, &rerr)) {
             std::fprintf(stderr, "%s: error: %s\n", refFile.c_str(), rerr.c_str());
-            return 1;
+            return fail();
         }
         const Bounds2i pb = scene->filmParams.pixelBounds();
         if (reference.width != pb.width() || reference.height != pb.height() ||
@@ -234,7 +252,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "%s: error: reference is %dx%d with %d channels; the film "
                                  "gives %dx%d RGB\n", refFile.c_str(), reference.width,
                          reference.height, reference.channels, pb.width(), pb.height());
-            return 1;
+            return fail();
         }
         ro.onPass = [&](int passSpp, double elapsed, const Film& film) {
             if (curveCost > 0.01 * elapsed) return;
@@ -264,11 +282,31 @@ int main(int argc, char** argv) {
         };
     };
     Checkpointer checkpoint(outFile, checkpointEvery, metadata);
-    if (checkpointEvery >= 0.0)
+    if (checkpointEvery >= 0.0 && root)
         ro.onPass = chainOnPass(std::move(ro.onPass), [&](int spp, double t, const Film& film) {
             checkpoint.onPass(spp, t, film);
         });
+    if (ranks) {
+        if (ranks->size() > 1 && guideSettings.autoSpp > 0) {
+            std::fprintf(stderr, "error: --guide-param auto=N is not supported on several ranks "
+                                 "yet (docs/DISTRIBUTED.md)\n");
+            return fail();
+        }
+        if (field && !field->sharesPasses()) {
+            std::fprintf(stderr, "error: this guide (%s) cannot be learned by several ranks "
+                                 "yet (directions=tree; docs/DISTRIBUTED.md)\n",
+                         guide.c_str());
+            return fail();
+        }
+        if (!ranks->allOk(true)) {
+            std::fprintf(stderr, "rlpbrt: another rank failed before rendering; nothing "
+                                 "rendered\n");
+            return 1;
+        }
+        ro.ranks = ranks;
+    }
     RenderResult r = render(*scene, ro);
+    if (!root) return r.cancelled ? 130 : 0;  // rank 0 writes the outputs
 
     ImageMetadata meta = metadata(r.spp, r.seconds);
     std::string err;
@@ -341,6 +379,15 @@ int main(int argc, char** argv) {
         j["nonfinite_samples"] = s.nonFinite;
         j["cancelled"] = r.cancelled;
         j["checkpoints"] = checkpoint.written();
+        // A distributed render: its ranks, and the bytes rank 0 put into their collectives
+        // (film tiles, guide statistics, decisions) in all and per pass.
+        j["ranks"] = r.ranks;
+        j["passes"] = r.passes;
+        j["bytes_exchanged"] = r.bytesExchanged;
+        j["bytes_exchanged_per_pass"] = r.passes ? double(r.bytesExchanged) / r.passes : 0.0;
+        // Rank 0's wall seconds in the collectives during the render (waiting for slower
+        // ranks included).
+        j["exchange_seconds"] = r.secondsExchanging;
         std::ofstream f(statsFile);
         f << j.dump(2) << "\n";
         if (!f) {

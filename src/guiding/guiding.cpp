@@ -32,6 +32,10 @@ void GuidingField::setPatches(uint32_t, std::function<bool(uint32_t, glm::vec3*,
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
 
+void GuidingField::endPassShared(const SumAcrossProcesses&) { endPass(); }
+
+bool GuidingField::sharesPasses() const { return false; }
+
 float GuidingField::irradianceEstimate(int region, const glm::vec3& n) const {
     return scatteredEstimate(region,
                              [&n](const glm::vec3& w) { return std::max(0.f, glm::dot(w, n)); });

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -64,6 +65,12 @@ struct SelectionSample {
     float pOther = 0.f;
     float scale = 0.f;
 };
+
+// Sums a flat array element-wise over all the processes that learn one field together (the
+// ranks of a distributed render), leaving the same sums, bit for bit, in every process's
+// array. Every process calls it the same number of times with arrays of the same sizes. The
+// guiding layer knows no more of the processes than this.
+using SumAcrossProcesses = std::function<void(std::vector<double>&)>;
 
 class GuidingField;
 class VertexGuide;
@@ -196,6 +203,17 @@ public:
     // Applies the recorded targets (a running mean per stratum: alpha = 1/(1+visits) by
     // default, or a fixed alpha) and rebuilds the CDFs.
     virtual void endPass() = 0;
+    // endPass() for a field that several processes learn together: each recorded the slots
+    // of its own work items (the others' slots are empty here). The pass statistics of the
+    // slots (per stratum the sum of the targets and their count, the selection sums, the
+    // medium requests) go through `sum` as flat arrays and are applied alike, so every
+    // process ends the pass with the same field, and one that learned all the records alone
+    // would differ only by the order of floating-point sums. The default applies this
+    // process's records only (endPass()).
+    virtual void endPassShared(const SumAcrossProcesses& sum);
+    // Whether endPassShared shares everything the field learns (false: the processes' fields
+    // would drift apart, so a distributed render refuses the field). Default: false.
+    virtual bool sharesPasses() const;
 
     // ---- Reporting and saving.
     // Memory of the learned data in bytes (tables, CDFs, points, kd-tree; not the per-pass

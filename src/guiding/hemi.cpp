@@ -426,6 +426,10 @@ void HemiField::updateTreeRegions() {
     }
 }
 
+void HemiField::endPassShared(const SumAcrossProcesses& sum) {
+    table_.endPassShared(params_.alphaVisits, params_.fixedAlpha, policy(), sum);
+}
+
 size_t HemiField::bytes() const {
     return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
            frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +

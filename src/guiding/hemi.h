@@ -129,6 +129,9 @@ public:
     void record(int slot, int region, const glm::vec3& w, float target,
                 int bin = -1) override;
     void endPass() override;
+    void endPassShared(const SumAcrossProcesses& sum) override;
+    // Not with directions=tree: its adaptive trees are not shared yet.
+    bool sharesPasses() const override { return !trees_; }
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;

@@ -45,15 +45,45 @@ void SelectionLearner::record(int slot, int region, const SelectionSample& s) {
                b, d});
 }
 
-void SelectionLearner::endPass() {
-    size_t total = 0;
-    for (const SlotBuffer& s : slots_) total += s.samples.size();
+bool SelectionLearner::allocate(uint64_t total) {
     if (selection_.empty()) {
-        if (total == 0) return;  // memory only once the integrator learns selections
+        if (total == 0) return false;  // memory only once the integrator learns selections
         sums_.assign(regions_ * kCandidates, 0.0);
         weights_.assign(regions_, 0.0);
         selection_.assign(regions_, -1.f);
     }
+    return true;
+}
+
+void SelectionLearner::candidateSums(size_t b, size_t e, double* add) const {
+    for (size_t i = b; i < e; ++i) {
+        const Sample& x = merged_[i];
+        for (int k = 0; k < kCandidates; ++k) {
+            const double p = double(x.b) + double(candidate(k)) * double(x.d);
+            add[k] += p > 0.0 ? double(x.a) / p : std::numeric_limits<double>::infinity();
+        }
+    }
+}
+
+void SelectionLearner::update(size_t r, const double* add, double count) {
+    double* sums = &sums_[r * kCandidates];
+    for (int k = 0; k < kCandidates; ++k) sums[k] = kDecay * sums[k] + add[k];
+    weights_[r] = kDecay * weights_[r] + count;
+    if (weights_[r] < kMinSamples) return;
+    int best = -1;
+    for (int k = 0; k < kCandidates; ++k)
+        if (std::isfinite(sums[k]) && (best < 0 || sums[k] < sums[best])) best = k;
+    selection_[r] = best < 0 ? -1.f : candidate(best);
+}
+
+size_t SelectionLearner::pendingSamples() const {
+    size_t total = 0;
+    for (const SlotBuffer& s : slots_) total += s.samples.size();
+    return total;
+}
+
+void SelectionLearner::endPass() {
+    if (!allocate(pendingSamples())) return;
     const size_t regions = regions_;
     mergeByRegion<Sample>(
         slots_, [](const SlotBuffer& s) -> const std::vector<Sample>& { return s.samples; },
@@ -62,23 +92,46 @@ void SelectionLearner::endPass() {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 256),
                       [&](const tbb::blocked_range<size_t>& range) {
         for (size_t r = range.begin(); r != range.end(); ++r) {
-            double* sums = &sums_[r * kCandidates];
             double add[kCandidates] = {};
             const size_t b = r == 0 ? 0 : start_[r - 1], e = start_[r];
-            for (size_t i = b; i < e; ++i) {
-                const Sample& x = merged_[i];
-                for (int k = 0; k < kCandidates; ++k) {
-                    const double p = double(x.b) + double(candidate(k)) * double(x.d);
-                    add[k] += p > 0.0 ? double(x.a) / p : std::numeric_limits<double>::infinity();
-                }
-            }
-            for (int k = 0; k < kCandidates; ++k) sums[k] = kDecay * sums[k] + add[k];
-            weights_[r] = kDecay * weights_[r] + double(e - b);
-            if (weights_[r] < kMinSamples) continue;
-            int best = -1;
-            for (int k = 0; k < kCandidates; ++k)
-                if (std::isfinite(sums[k]) && (best < 0 || sums[k] < sums[best])) best = k;
-            selection_[r] = best < 0 ? -1.f : candidate(best);
+            candidateSums(b, e, add);
+            update(r, add, double(e - b));
+        }
+    });
+    for (SlotBuffer& s : slots_) s.samples.clear();
+}
+
+void SelectionLearner::endPassShared(const SumAcrossProcesses& sum, uint64_t total) {
+    if (!allocate(total)) {
+        for (SlotBuffer& s : slots_) s.samples.clear();
+        return;
+    }
+    const size_t regions = regions_;
+    mergeByRegion<Sample>(
+        slots_, [](const SlotBuffer& s) -> const std::vector<Sample>& { return s.samples; },
+        regions, &start_, &merged_);
+    std::vector<double> counts(regions, 0.0);
+    for (size_t r = 0; r < regions; ++r)
+        counts[r] = double(start_[r] - (r == 0 ? 0 : start_[r - 1]));
+    if (total > 0) sum(counts);
+    std::vector<size_t> touched;
+    for (size_t r = 0; r < regions; ++r)
+        if (counts[r] > 0.0) touched.push_back(r);
+    std::vector<double> add(touched.size() * kCandidates, 0.0);
+    for (size_t i = 0; i < touched.size(); ++i) {
+        const size_t r = touched[i];
+        candidateSums(r == 0 ? 0 : start_[r - 1], start_[r], &add[i * kCandidates]);
+    }
+    if (!touched.empty()) sum(add);
+    // Every region decays, sampled or not.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 256),
+                      [&](const tbb::blocked_range<size_t>& range) {
+        const double none[kCandidates] = {};
+        for (size_t r = range.begin(); r != range.end(); ++r) {
+            const auto it = std::lower_bound(touched.begin(), touched.end(), r);
+            const bool has = it != touched.end() && *it == r;
+            update(r, has ? &add[size_t(it - touched.begin()) * kCandidates] : none,
+                   counts[r]);
         }
     });
     for (SlotBuffer& s : slots_) s.samples.clear();

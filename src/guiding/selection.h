@@ -44,6 +44,14 @@ public:
     void record(int slot, int region, const SelectionSample& s);
     // Merges the pass's samples in slot order (deterministic) and updates the selections.
     void endPass();
+    // Samples recorded in this pass so far (all slots).
+    size_t pendingSamples() const;
+    // endPass for a learner that several processes share (GuidingField::endPassShared):
+    // `total` is the sum over the processes of pendingSamples(); each region's sample count
+    // and sums over the candidates are summed through `sum` (each process adds its samples
+    // in slot order, the processes' sums are added in rank order), then applied as endPass
+    // applies its own.
+    void endPassShared(const SumAcrossProcesses& sum, uint64_t total);
 
     // The learned selection of a region, or -1 if it has none (too few samples, or none that
     // carried light).
@@ -66,6 +74,13 @@ private:
     struct alignas(64) SlotBuffer {
         std::vector<Sample> samples;
     };
+    // Allocates the learned data at the first pass with samples; false while there is none.
+    bool allocate(uint64_t total);
+    // A region's candidate sums of the pass's samples [begin, end) (merged_ positions).
+    void candidateSums(size_t begin, size_t end, double* add) const;
+    // Decays region r's sums, adds the pass's (add, count samples) and picks its selection.
+    void update(size_t r, const double* add, double count);
+
     size_t regions_ = 0;
     std::vector<SlotBuffer> slots_;
     // Allocated at the first pass with samples (a render that does not learn selections

@@ -227,15 +227,19 @@ void StrataTable::beginPass(int numSlots) {
     selection_.beginPass(numSlots);
 }
 
-void StrataTable::applyRegion(size_t region, const Record* begin, const Record* end,
-                              bool alphaVisits, double fixedAlpha, double* sums,
-                              uint64_t* counts, double* scratch, const PolicyBuilder& policy) {
+void StrataTable::accumulate(const Record* begin, const Record* end, double* sums,
+                             uint64_t* counts) const {
     std::fill(sums, sums + strata_, 0.0);
     std::fill(counts, counts + strata_, uint64_t(0));
     for (const Record* r = begin; r != end; ++r) {  // merge order: slot, then record order
         sums[r->stratum] += double(r->target);
         ++counts[r->stratum];
     }
+}
+
+void StrataTable::applySums(size_t region, const double* sums, const uint64_t* counts,
+                            bool alphaVisits, double fixedAlpha, double* scratch,
+                            const PolicyBuilder& policy) {
     double* q = &q_[block_[region] * size_t(strata_)];
     uint64_t* visits = &visits_[block_[region] * size_t(strata_)];
     for (int j = 0; j < strata_; ++j) {
@@ -256,6 +260,19 @@ void StrataTable::applyRegion(size_t region, const Record* begin, const Record* 
         visits[j] += m;
     }
     rebuild(region, policy, scratch);
+}
+
+void StrataTable::applyRegion(size_t region, const Record* begin, const Record* end,
+                              bool alphaVisits, double fixedAlpha, double* sums,
+                              uint64_t* counts, double* scratch, const PolicyBuilder& policy) {
+    accumulate(begin, end, sums, counts);
+    applySums(region, sums, counts, alphaVisits, fixedAlpha, scratch, policy);
+}
+
+void StrataTable::addFreshBlocks(const std::vector<size_t>& fresh) {
+    if (!fresh.empty())
+        addBlocks(fresh, std::vector<const double*>(fresh.size(), nullptr),
+                  std::vector<const uint64_t*>(fresh.size(), nullptr));
 }
 
 void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy) {
@@ -283,9 +300,7 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
                 const size_t b = r == 0 ? 0 : regionStart_[r - 1];
                 if (regionStart_[r] != b && block_[r] == 0) fresh.push_back(r);
             }
-            if (!fresh.empty())
-                addBlocks(fresh, std::vector<const double*>(fresh.size(), nullptr),
-                          std::vector<const uint64_t*>(fresh.size(), nullptr));
+            addFreshBlocks(fresh);
         }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, regions_, 256),
                           [&](const tbb::blocked_range<size_t>& range) {
@@ -300,6 +315,87 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
                                   applyRegion(r, merged_.data() + b, merged_.data() + e,
                                               alphaVisits, fixedAlpha, sums.data(),
                                               counts.data(), scratch.data(), policy);
+                              }
+                          });
+    }
+    for (SlotBuffer& s : slots_) {
+        s.records.clear();
+        s.rejectedTargets = s.rejectedRecords = 0;
+    }
+}
+
+void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
+                                const PolicyBuilder& policy, const SumAcrossProcesses& sum) {
+    // 1. Counters, then the records per region (this process's, grouped by region).
+    constexpr size_t kHead = 4;
+    std::vector<double> head(kHead + regions_, 0.0);
+    uint64_t total = 0;
+    for (const SlotBuffer& s : slots_) {
+        total += s.records.size();
+        head[1] += double(s.rejectedTargets);
+        head[2] += double(s.rejectedRecords);
+    }
+    head[0] = double(total);
+    head[3] = double(selection_.pendingSamples());
+    if (total > 0 && regions_ > 0)
+        mergeByRegion<Record>(
+            slots_, [](const SlotBuffer& s) -> const std::vector<Record>& { return s.records; },
+            regions_, &regionStart_, &merged_);
+    else
+        regionStart_.assign(regions_ + 1, 0);
+    auto range = [&](size_t r) {
+        return std::make_pair(r == 0 ? uint64_t(0) : regionStart_[r - 1], regionStart_[r]);
+    };
+    for (size_t r = 0; r < regions_; ++r) {
+        const auto [b, e] = range(r);
+        head[kHead + r] = double(e - b);
+    }
+    sum(head);
+    const uint64_t allRecords = uint64_t(head[0]);
+    ++stats_.passes;
+    stats_.records += allRecords;
+    stats_.rejectedTargets += uint64_t(head[1]);
+    stats_.rejectedRecords += uint64_t(head[2]);
+    selection_.endPassShared(sum, uint64_t(head[3]));
+    stats_.selectionRegions = selection_.learnedRegions();
+    stats_.selectionMean = selection_.meanSelection();
+    if (allRecords > 0 && regions_ > 0) {
+        // 2. Per stratum the sum of the targets and their count, for the regions that
+        // received records anywhere (in region order).
+        std::vector<size_t> touched;
+        for (size_t r = 0; r < regions_; ++r)
+            if (head[kHead + r] > 0.0) touched.push_back(r);
+        const size_t n = size_t(strata_);
+        std::vector<double> body(touched.size() * 2 * n, 0.0);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 256),
+                          [&](const tbb::blocked_range<size_t>& rs) {
+                              std::vector<uint64_t> counts(n);
+                              for (size_t i = rs.begin(); i != rs.end(); ++i) {
+                                  const auto [b, e] = range(touched[i]);
+                                  double* sums = &body[i * 2 * n];
+                                  accumulate(merged_.data() + b, merged_.data() + e, sums,
+                                             counts.data());
+                                  for (size_t j = 0; j < n; ++j)
+                                      sums[n + j] = double(counts[j]);
+                              }
+                          });
+        sum(body);
+        if (lazy_) {
+            std::vector<size_t> fresh;
+            for (size_t r : touched)
+                if (block_[r] == 0) fresh.push_back(r);
+            addFreshBlocks(fresh);
+        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 256),
+                          [&](const tbb::blocked_range<size_t>& rs) {
+                              std::vector<uint64_t> counts(n);
+                              std::vector<double> scratch(n + smoothingScratch());
+                              for (size_t i = rs.begin(); i != rs.end(); ++i) {
+                                  const double* sums = &body[i * 2 * n];
+                                  for (size_t j = 0; j < n; ++j)
+                                      counts[j] = uint64_t(sums[n + j]);
+                                  applySums(touched[i], sums, counts.data(), alphaVisits,
+                                            fixedAlpha, scratch.data(), policy);
                               }
                           });
     }

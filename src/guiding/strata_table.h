@@ -109,6 +109,13 @@ public:
     // Applies the records in slot order (running mean if alphaVisits, else fixed alpha) and
     // rebuilds the CDFs of the regions that received records.
     void endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy);
+    // endPass for a table that several processes learn together (GuidingField::
+    // endPassShared): the counters and each region's number of records are summed first,
+    // then, for the regions that received records anywhere, each stratum's sum of targets
+    // and count (each process adds its own records in slot order, the processes' sums are
+    // added in rank order), and the selection learner's statistics. The update is endPass's.
+    void endPassShared(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy,
+                       const SumAcrossProcesses& sum);
 
     // Replaces Q and visits (regions x strata, region-major; checked by the caller) and
     // rebuilds every CDF. Lazy: regions whose Q and visits are the prior's share its block.
@@ -147,6 +154,15 @@ private:
     void applyRegion(size_t region, const Record* begin, const Record* end, bool alphaVisits,
                      double fixedAlpha, double* sums, uint64_t* counts, double* scratch,
                      const PolicyBuilder& policy);
+    // The targets' sums and counts per stratum of a region's records (applyRegion's first
+    // step), and the update of the region from them (its second).
+    void accumulate(const Record* begin, const Record* end, double* sums,
+                    uint64_t* counts) const;
+    void applySums(size_t region, const double* sums, const uint64_t* counts,
+                   bool alphaVisits, double fixedAlpha, double* scratch,
+                   const PolicyBuilder& policy);
+    // Gives the regions in `fresh` (lazy tables) blocks of their own.
+    void addFreshBlocks(const std::vector<size_t>& fresh);
     // Sets the tables to `blocks` blocks of Q = init and no visits (estimates init, CDFs
     // zero until rebuilt), with exact capacities.
     void untrainedBlocks(size_t blocks);

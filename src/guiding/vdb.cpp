@@ -474,6 +474,11 @@ void VdbField::endPass() {
     if (volume_) volume_->endPass();
 }
 
+void VdbField::endPassShared(const SumAcrossProcesses& sum) {
+    table_.endPassShared(params_.alphaVisits, params_.fixedAlpha, policy(), sum);
+    if (volume_) volume_->endPassShared(sum);
+}
+
 size_t VdbField::gridBytes() const { return size_t(grid_->grid->memUsage()); }
 
 size_t VdbField::bytes() const {

@@ -89,6 +89,8 @@ public:
     void record(int slot, int region, const glm::vec3& w, float target,
                 int bin = -1) override;
     void endPass() override;
+    void endPassShared(const SumAcrossProcesses& sum) override;
+    bool sharesPasses() const override { return true; }
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;

@@ -152,6 +152,42 @@ void VdbVolume::endPass() {
     }
 }
 
+void VdbVolume::endPassShared(const SumAcrossProcesses& sum) {
+    table_.endPassShared(params_.alphaVisits, params_.fixedAlpha, policy(), sum);
+    // Each slot's requests are one process's (the others' slots are empty): the counts per
+    // slot, then the keys at their slot's place, summed, are every process's requests in
+    // slot order (keys below 2^53 are exact in doubles; the others add zeros).
+    std::vector<double> counts(requests_.size(), 0.0);
+    for (size_t s = 0; s < requests_.size(); ++s) counts[s] = double(requests_[s].order.size());
+    sum(counts);
+    size_t total = 0;
+    std::vector<size_t> start(requests_.size());
+    for (size_t s = 0; s < requests_.size(); ++s) {
+        start[s] = total;
+        total += size_t(counts[s]);
+    }
+    if (total > 0) {
+        std::vector<double> keys(total, 0.0);
+        for (size_t s = 0; s < requests_.size(); ++s)
+            for (size_t i = 0; i < requests_[s].order.size(); ++i)
+                keys[start[s] + i] = double(requests_[s].order[i]);
+        sum(keys);
+        const size_t before = coords_.size();
+        for (double k : keys) {
+            if (coords_.size() >= params_.maxVoxels) break;
+            activate(voxelFromKey(uint64_t(k)));
+        }
+        if (coords_.size() > before) {
+            confidence_.resize(coords_.size(), params_.warmup > 0.0 ? 0.f : 1.f);
+            table_.grow(coords_.size(), params_.init, policy());
+        }
+    }
+    for (Requests& r : requests_) {
+        r.order.clear();
+        r.seen.clear();
+    }
+}
+
 bool VdbVolume::validCells(const std::vector<glm::ivec3>& coords) const {
     std::unordered_set<uint64_t> seen;
     for (const glm::ivec3& c : coords)

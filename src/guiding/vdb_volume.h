@@ -66,6 +66,10 @@ public:
     void record(int slot, int cell, const glm::vec3& w, float target);
     // Applies the records, then activates the requested voxels (slot order, then request order).
     void endPass();
+    // endPass for a volume that several processes learn together (GuidingField::
+    // endPassShared): the tables' statistics are summed, and the requests of all slots are
+    // gathered in slot order, so every process activates the same voxels in the same order.
+    void endPassShared(const SumAcrossProcesses& sum);
 
     int cells() const { return int(table_.regions()); }
     int strata() const { return table_.strata(); }

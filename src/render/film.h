@@ -94,6 +94,10 @@ public:
     float weightSum(int x, int y) const { return pixel(x, y).weightSum; }
     // Resets all sums to zero (to reuse the tile for the next pass).
     void clear();
+    // The sums as a flat array of floats (4 per pixel: RGB and weight), for exchanging tiles
+    // between the ranks of a distributed render.
+    float* data() { return reinterpret_cast<float*>(pixels_.data()); }
+    size_t floatCount() const { return pixels_.size() * 4; }
 
 private:
     friend class Film;
@@ -113,6 +117,7 @@ private:
     FilterTable table_;
     float maxSampleLuminance_;
     std::vector<Pixel> pixels_;
+    static_assert(sizeof(Spectrum) == 3 * sizeof(float), "FilmTile::data() needs plain floats");
 };
 
 class Film {

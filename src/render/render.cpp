@@ -124,6 +124,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
     constexpr double kAutoMargin = 1.15;
     Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
+    // Distributed (docs/DISTRIBUTED.md): this rank renders its tiles of every pass. The auto
+    // trial is not distributed yet (the command line refuses auto=N on several ranks).
+    Ranks* const ranks = options.ranks;
+    if (ranks) trial = Trial::Done;
     std::unique_ptr<PathIntegrator> plainIntegrator;
     std::unique_ptr<PassMoments> guidedMoments, plainMoments;
     // The pixel means of the passes before the trial: the trial's reference values.
@@ -150,6 +154,20 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // 1.40 s), cornell-box 0.003341 / 0.92 s -> 0.003338 / 0.85 s; at 64 spp unchanged.
     constexpr int kRouletteMinSpp = 8;
     PixelEstimates estimates(film.pixelBounds());
+    // The tiles' sums exchanged after each pass: every rank needs the whole film when the
+    // integrator reads the image so far (the pixel estimates), else rank 0 alone.
+    const bool everyoneNeedsFilm = field && integrator.wantsPixelEstimate();
+    std::vector<float> exchange;
+    const double exchangeBefore = ranks ? ranks->secondsExchanging() : 0.0;
+    if (ranks) {
+        size_t n = 0;
+        for (const auto& t : tileFilms) n += t->floatCount();
+        exchange.resize(n);
+    }
+    // The guide's pass statistics: summed over the ranks, the same on every rank.
+    const guiding::SumAcrossProcesses sumAcross = [ranks](std::vector<double>& v) {
+        ranks->sumDoubles(v.data(), v.size());
+    };
 
     double start = now();
     long long samplesDone = 0;
@@ -163,7 +181,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             count = std::min(count, totalSpp - result.spp);
         } else if (pass > 0) {
             // Only what fits in the budget at the speed so far.
-            const double elapsed = now() - start;
+            double elapsed = now() - start;
+            if (ranks) ranks->broadcast(&elapsed, sizeof(elapsed));  // rank 0's clock decides
             const double perSpp = elapsed / result.spp;
             count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
         }
@@ -214,6 +233,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (learningPass) field->beginPass(int(tiles.size()));
         arena.execute([&] {
             tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+                if (!ownsTile(ranks, ti)) return;
                 std::unique_ptr<Sampler> passSampler = passProto ? passProto->clone() : nullptr;
                 Sampler& sampler = passSampler ? *passSampler : *samplers.local();
                 PathStats& st = stats.local();
@@ -252,7 +272,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             });
         });
         // The guide learns between passes: every pass samples from a frozen policy.
-        if (learningPass) field->endPass();
+        if (learningPass) {
+            if (ranks)
+                field->endPassShared(sumAcross);
+            else
+                field->endPass();
+        }
         const double secondsPerSample =
             (cpuNow() - passStart) / (double(pixelsPerPass) * double(count));
         if (trial == Trial::MeasureGuided) {
@@ -279,7 +304,23 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             plainMoments.reset();
             history.reset();
         }
-        film.mergeTiles(tileFilms);
+        if (ranks) {
+            // Each tile was rendered by one rank: the sums are exact, and the film is then
+            // merged in tile order as by one process.
+            size_t off = 0;
+            for (auto& t : tileFilms) {
+                std::copy(t->data(), t->data() + t->floatCount(), exchange.data() + off);
+                off += t->floatCount();
+            }
+            ranks->sumDisjointFloats(exchange.data(), exchange.size(), everyoneNeedsFilm);
+            off = 0;
+            for (auto& t : tileFilms) {
+                std::copy(exchange.data() + off, exchange.data() + off + t->floatCount(),
+                          t->data());
+                off += t->floatCount();
+            }
+        }
+        if (!ranks || everyoneNeedsFilm || ranks->rank() == 0) film.mergeTiles(tileFilms);
         for (auto& t : tileFilms) t->clear();
         if (guidedPass && passIntegrator.wantsPixelEstimate() &&
             result.spp + count >= kRouletteMinSpp)
@@ -292,7 +333,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (options.progress)
             printProgress(pass, result.spp, totalSpp, elapsed, options.timeBudget,
                           samplesDone / std::max(elapsed, 1e-9));
-        if (options.cancel && options.cancel->load()) {
+        bool stop = options.cancel && options.cancel->load();
+        if (ranks) ranks->broadcast(&stop, sizeof(stop));  // rank 0 decides
+        if (stop) {
             result.cancelled = true;
             break;
         }
@@ -302,6 +345,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     if (options.progress) std::fprintf(stderr, "\n");
     result.seconds = now() - start;
     for (const auto& s : stats) result.stats.add(s);
+    result.passes = pass;
+    if (ranks) {
+        PathStats& s = result.stats;
+        double sums[5] = {double(s.paths), double(s.rays), double(s.vertices),
+                          double(s.zeroRadiancePaths), double(s.nonFinite)};
+        ranks->sumDoubles(sums, 5);
+        s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]), s.vertices = uint64_t(sums[2]);
+        s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
+        result.ranks = ranks->size();
+        result.bytesExchanged = ranks->bytesExchanged();
+        result.secondsExchanging = ranks->secondsExchanging() - exchangeBefore;
+    }
     result.image = film.toImage();
     return result;
 }

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "render/distributed.h"
 #include "render/image.h"
 #include "render/integrator.h"
 #include "render/scene.h"
@@ -20,6 +21,12 @@ struct RenderOptions {
     GuideSettings guide;         // guiding field (null = plain path tracing) and mixture
     // Called after each pass with the image so far (for curves and checkpoints).
     std::function<void(int spp, double seconds, const Film& film)> onPass;
+    // The ranks of a distributed render (null: this process renders alone). Each rank
+    // renders the tiles ownsTile() gives it, of every pass; the film sums go to rank 0 (to
+    // every rank where the integrator reads the image so far), the guide's pass statistics
+    // to every rank (GuidingField::endPassShared), and rank 0's clock and cancel flag decide
+    // for all. Only rank 0's result image and onPass calls are meaningful.
+    Ranks* ranks = nullptr;
 };
 
 struct RenderResult {
@@ -39,6 +46,10 @@ struct RenderResult {
         int guidedSpp = 0;
         double guidedCost = 0.0, plainCost = 0.0;
     } autoTrial;
+    int ranks = 1;                // processes that rendered (RenderOptions::ranks)
+    int passes = 0;
+    uint64_t bytesExchanged = 0;  // this rank's payload in the ranks' collectives
+    double secondsExchanging = 0.0;  // ... and its wall time in them (during the render)
 };
 
 RenderResult render(const Scene& scene, const RenderOptions& options);

@@ -16,7 +16,10 @@
 #include "render/render.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "cli_run.h"
 #include "shared_data.h"
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace rlpbrt {
 namespace {
@@ -203,6 +206,50 @@ std::string sceneTestName(const ::testing::TestParamInfo<std::tuple<const char*,
     for (char& c : n)
         if (!isalnum(static_cast<unsigned char>(c))) c = '_';
     return n;
+}
+
+// A distributed render (docs/DISTRIBUTED.md): the command line on 2 ranks (mpirun), 64 spp,
+// plain and guided, meets the same bounds.
+TEST(DistributedReference, TwoRanksMatchPbrtV3At64spp) {
+    RLPBRT_REQUIRE_SHARED();
+    struct stat st;
+    if (std::string(RLPBRT_MPIEXEC).empty() || stat(RLPBRT_MPIEXEC, &st) != 0)
+        GTEST_SKIP() << "mpirun not found (CMake's MPIEXEC_EXECUTABLE)";
+    const std::vector<ManifestRow> rows = readManifest();
+    for (const char* id : {"cornell-box__scene", "veach-bidir__bidir"})
+        for (const char* guide : {"none", "hemi"}) {
+            SCOPED_TRACE(std::string(id) + " " + guide);
+            const ManifestRow* row = nullptr;
+            for (const auto& r : rows)
+                if (r.id == id) row = &r;
+            ASSERT_NE(row, nullptr);
+            const std::string out = "/tmp/rlpbrt-distributed-ref-" + std::to_string(getpid()) +
+                                    "-" + guide + ".exr";
+            const test::CliRun run = test::runCommand(
+                // (no LeakSanitizer in the ranks: Open MPI's own leaks, distributed_test.cpp)
+                std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+                            "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" "
+                            "timeout 600 ") +
+                RLPBRT_MPIEXEC + " --oversubscribe -np 2 " + RLPBRT_BINARY + " " +
+                test::sharedDir() + "/scenes/" + row->scene + " --spp 64 --seed 1 --quiet " +
+                "--nthreads 1 --guide " + guide + " -o " + out);
+            ASSERT_EQ(run.status, 0) << run.output;
+            Image img, ref;
+            std::string err;
+            ASSERT_TRUE(readImage(out, &img, &err)) << err;
+            std::remove(out.c_str());
+            ASSERT_TRUE(readImage(test::sharedDir() + "/references/" + row->id + ".exr", &ref,
+                                  &err))
+                << err;
+            ASSERT_EQ(img.width, ref.width);
+            ASSERT_EQ(img.height, ref.height);
+            EXPECT_FALSE(hasNonFinite(img));
+            const double rel = relMseTrimmed(img, ref), bias = blockBias(img, ref);
+            EXPECT_LE(rel, 1.5 * row->relmse64);
+            EXPECT_LE(bias, std::max(0.02, 1.5 * row->blockBias64));
+            std::printf("%s [%s, 2 ranks]: relmse %.6g (pbrt-v3 %.6g), block bias %.4g\n",
+                        id, guide, rel, row->relmse64, bias);
+        }
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ReferenceTest,

@@ -1,0 +1,136 @@
+#include "cli/distributed.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cstdlib>
+#include <vector>
+
+namespace rlpbrt {
+
+namespace {
+
+// Whether a launcher started this process as one rank of a job: Open MPI's mpirun, or a PMI
+// or PMIx process manager (Slurm's srun, MPICH's hydra).
+bool launchedByMpi() {
+    for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE", "PMI_RANK"})
+        if (std::getenv(v)) return true;
+    return false;
+}
+
+// The sum of sumDoubles: declared non-commutative so that MPI combines the ranks' terms in
+// rank order (MPI 4.0, section 6.9.5), which makes the result independent of arrival order.
+// (a + b == b + a in IEEE arithmetic: only the order of the terms matters.)
+void orderedSum(void* in, void* inout, int* len, MPI_Datatype*) {
+    const double* a = static_cast<const double*>(in);
+    double* b = static_cast<double*>(inout);
+    for (int i = 0; i < *len; ++i) b[i] = a[i] + b[i];
+}
+
+double now() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+// Adds the wall time of a scope to a counter.
+struct Timed {
+    explicit Timed(double* total) : total_(total), start_(now()) {}
+    ~Timed() { *total_ += now() - start_; }
+    double* total_;
+    double start_;
+};
+
+// Counts above INT_MAX go in chunks.
+constexpr size_t kChunk = size_t(1) << 28;
+
+class MpiRanks final : public Ranks {
+public:
+    MpiRanks() {
+        MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+        MPI_Comm_size(MPI_COMM_WORLD, &size_);
+        MPI_Op_create(&orderedSum, /*commute=*/0, &sumOp_);
+    }
+    ~MpiRanks() override { MPI_Op_free(&sumOp_); }
+    int rank() const override { return rank_; }
+    int size() const override { return size_; }
+
+    void sumDoubles(double* data, size_t n) override {
+        Timed t(&seconds_);
+        bytes_ += n * sizeof(double);
+        std::vector<double> out(rank_ == 0 ? std::min(n, kChunk) : 0);
+        for (size_t off = 0; off < n; off += kChunk) {
+            const int c = int(std::min(kChunk, n - off));
+            // Reduce to rank 0 in rank order, then the same bits to everyone.
+            MPI_Reduce(data + off, rank_ == 0 ? out.data() : nullptr, c, MPI_DOUBLE, sumOp_, 0,
+                       MPI_COMM_WORLD);
+            if (rank_ == 0) std::copy(out.begin(), out.begin() + c, data + off);
+            MPI_Bcast(data + off, c, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+        }
+    }
+
+    void sumDisjointFloats(float* data, size_t n, bool everyone) override {
+        Timed t(&seconds_);
+        bytes_ += n * sizeof(float);
+        for (size_t off = 0; off < n; off += kChunk) {
+            const int c = int(std::min(kChunk, n - off));
+            if (everyone)
+                MPI_Allreduce(MPI_IN_PLACE, data + off, c, MPI_FLOAT, MPI_SUM, MPI_COMM_WORLD);
+            else
+                MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : data + off,
+                           rank_ == 0 ? data + off : nullptr, c, MPI_FLOAT, MPI_SUM, 0,
+                           MPI_COMM_WORLD);
+        }
+    }
+
+    void broadcast(void* data, size_t bytes) override {
+        Timed t(&seconds_);
+        bytes_ += bytes;
+        char* p = static_cast<char*>(data);
+        for (size_t off = 0; off < bytes; off += kChunk)
+            MPI_Bcast(p + off, int(std::min(kChunk, bytes - off)), MPI_BYTE, 0, MPI_COMM_WORLD);
+    }
+
+    bool allOk(bool ok) override {
+        Timed t(&seconds_);
+        int v = ok ? 1 : 0, all = 0;
+        bytes_ += sizeof(int);
+        MPI_Allreduce(&v, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+        return all == 1;
+    }
+
+    uint64_t bytesExchanged() const override { return bytes_; }
+    double secondsExchanging() const override { return seconds_; }
+
+private:
+    int rank_ = 0, size_ = 1;
+    MPI_Op sumOp_;
+    uint64_t bytes_ = 0;
+    double seconds_ = 0.0;
+};
+
+}  // namespace
+
+DistributedSession::DistributedSession(int* argc, char*** argv) {
+    if (!launchedByMpi()) return;
+    // Only the main thread calls MPI (the render's worker threads never do).
+    int provided = 0;
+    MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+    initialised_ = true;
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size > 1) ranks_ = std::make_unique<MpiRanks>();
+}
+
+DistributedSession::~DistributedSession() {
+    ranks_.reset();
+    if (initialised_) MPI_Finalize();
+}
+
+void DistributedSession::abort(int code) {
+    if (initialised_) MPI_Abort(MPI_COMM_WORLD, code);
+    std::exit(code);
+}
+
+}  // namespace rlpbrt

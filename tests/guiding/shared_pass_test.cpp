@@ -1,0 +1,177 @@
+// GuidingField::endPassShared, the guide's side of a distributed render (docs/DISTRIBUTED.md):
+// K fields that each record the slots of their own "rank" and end their passes through a
+// sum over the K of them (threads standing in for processes) learn the field of one process
+// that recorded every slot and ended its passes with endPass(). hemi and vdb (surface and
+// medium tables, voxel activation), with learned selections and rejected targets.
+#include "guiding/guiding.h"
+#include "guiding/hemi.h"
+#include "guiding/vdb.h"
+#include "guiding/vdb_volume.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "guiding/test_scenes.h"
+
+namespace rlpbrt::guiding {
+namespace {
+
+// SumAcrossProcesses for K threads: each passes its array, the last to arrive adds them in
+// rank order and gives every thread the result.
+class ThreadSum {
+public:
+    explicit ThreadSum(int k) : k_(k), arrays_(size_t(k), nullptr) {}
+    void sum(int rank, std::vector<double>& v) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        arrays_[size_t(rank)] = &v;
+        const long generation = generation_;
+        if (++arrived_ < k_) {
+            cv_.wait(lock, [&] { return generation_ != generation; });
+            return;
+        }
+        std::vector<double> total(v.size(), 0.0);
+        for (std::vector<double>* a : arrays_) {
+            EXPECT_EQ(a->size(), total.size()) << "every rank passes arrays of the same size";
+            for (size_t i = 0; i < std::min(a->size(), total.size()); ++i) total[i] += (*a)[i];
+        }
+        for (std::vector<double>* a : arrays_) *a = total;
+        ++calls_;
+        arrived_ = 0;
+        ++generation_;
+        cv_.notify_all();
+    }
+    int calls() const { return calls_; }
+
+private:
+    int k_, arrived_ = 0, calls_ = 0;
+    long generation_ = 0;
+    std::vector<std::vector<double>*> arrays_;
+    std::mutex mutex_;
+    std::condition_variable cv_;
+};
+
+constexpr int kSlots = 7;
+
+// A unit square floor with a box of fog above it (the vdb backend's medium tables).
+SceneInfo foggyFloor() {
+    SceneInfo s = test::planeScene();
+    s.boundsMax = glm::vec3(1.f, 1.f, 0.5f);
+    s.mediaMin = glm::vec3(0.f);
+    s.mediaMax = glm::vec3(1.f, 1.f, 0.5f);
+    return s;
+}
+
+// The records of pass `pass` in slot s (the same on every rank that records the slot):
+// surface targets, medium requests and targets, selection samples, and a few bad targets.
+// The targets are multiples of 2^-24 below 1, whose sums in doubles are exact in any order.
+void recordSlot(GuidingField& f, int pass, int s) {
+    std::mt19937_64 rng(uint64_t(pass) * 1000 + uint64_t(s));
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    auto target = [&] { return float(rng() >> 40) * 0x1p-24f; };
+    for (int i = 0; i < 400; ++i) {
+        const glm::vec3 p(u(rng), u(rng), 0.f), n(0.f, 0.f, 1.f);
+        const int region = f.lookup(p, n);
+        glm::vec3 w = test::gaussianDirection(rng);
+        w.z = std::abs(w.z);
+        if (region >= 0) {
+            f.record(s, region, w, i % 97 == 0 ? -1.f : target());
+            SelectionSample x;
+            x.integrand = u(rng);
+            x.pdf = 0.2f + u(rng);
+            x.pGuide = u(rng);
+            x.pOther = u(rng);
+            x.scale = u(rng);
+            // (a few regions, so that they reach the learner's minimum of samples)
+            const glm::vec3 hub(i % 3 == 0 ? 0.2f : 0.7f, 0.5f, 0.f);
+            f.recordSelection(s, f.lookup(hub, n), x);
+        }
+        const glm::vec3 q(u(rng), u(rng), 0.5f * u(rng));
+        const int cell = f.lookupMedium(q);
+        if (cell >= 0)
+            f.record(s, cell, test::gaussianDirection(rng), target());
+        else if (i % 5 == 0)
+            f.requestMedium(s, q);
+    }
+}
+
+// Every query of the frozen policy, at every region, alike.
+void expectSameField(const GuidingField& a, const GuidingField& b, int regions) {
+    const GuidingStats sa = a.stats(), sb = b.stats();
+    EXPECT_EQ(sa.passes, sb.passes);
+    EXPECT_EQ(sa.records, sb.records);
+    EXPECT_EQ(sa.rejectedTargets, sb.rejectedTargets);
+    EXPECT_EQ(sa.learnedRegions, sb.learnedRegions);
+    EXPECT_EQ(sa.mediumCells, sb.mediumCells);
+    EXPECT_EQ(sa.selectionRegions, sb.selectionRegions);
+    EXPECT_EQ(sa.selectionMean, sb.selectionMean);
+    std::mt19937_64 rng(5);
+    std::vector<glm::vec3> dirs;
+    for (int i = 0; i < 32; ++i) dirs.push_back(test::gaussianDirection(rng));
+    int mismatches = 0;
+    for (int r = 0; r < regions; ++r) {
+        mismatches += a.confidence(r) != b.confidence(r);
+        mismatches += a.selection(r) != b.selection(r);
+        for (const glm::vec3& w : dirs) {
+            mismatches += a.pdf(r, w) != b.pdf(r, w);
+            mismatches += a.radiance(r, w) != b.radiance(r, w);
+        }
+    }
+    EXPECT_EQ(mismatches, 0) << "over " << regions << " regions";
+}
+
+template <class Field>
+void checkShared(const char* backend, const SceneInfo& scene,
+                 std::map<std::string, std::string> params,
+                 const std::function<int(const Field&)>& regions) {
+    constexpr int kRanks = 3, kPasses = 3;
+    auto one = test::makeField<Field>(backend, scene, params);
+    std::vector<std::unique_ptr<Field>> ranks;
+    for (int k = 0; k < kRanks; ++k)
+        ranks.push_back(test::makeField<Field>(backend, scene, params));
+    ASSERT_TRUE(one);
+    ThreadSum sum(kRanks);
+    for (int pass = 0; pass < kPasses; ++pass) {
+        one->beginPass(kSlots);
+        for (int s = 0; s < kSlots; ++s) recordSlot(*one, pass, s);
+        one->endPass();
+        std::vector<std::thread> threads;
+        for (int k = 0; k < kRanks; ++k)
+            threads.emplace_back([&, k] {
+                Field& f = *ranks[size_t(k)];
+                f.beginPass(kSlots);
+                for (int s = k; s < kSlots; s += kRanks) recordSlot(f, pass, s);
+                f.endPassShared([&](std::vector<double>& v) { sum.sum(k, v); });
+            });
+        for (std::thread& t : threads) t.join();
+    }
+    EXPECT_GT(one->stats().records, 1000u);
+    EXPECT_GT(one->stats().rejectedTargets, 0u);
+    EXPECT_GT(one->stats().selectionRegions, 0u);
+    EXPECT_GE(sum.calls(), 2 * kPasses);
+    for (int k = 0; k < kRanks; ++k) {
+        SCOPED_TRACE(k);
+        expectSameField(*one, *ranks[size_t(k)], regions(*one));
+    }
+}
+
+TEST(SharedPass, HemiRanksLearnTheFieldOfOneProcess) {
+    checkShared<HemiField>("hemi", test::cornerScene(), {{"mix", "learn"}},
+                           [](const HemiField& f) { return f.numRegions(); });
+}
+
+TEST(SharedPass, VdbRanksLearnTheFieldOfOneProcessWithMedia) {
+    checkShared<VdbField>("vdb", foggyFloor(), {{"mix", "learn"}, {"volume-voxel", "4"}},
+                          [](const VdbField& f) {
+                              EXPECT_GT(f.volume()->cells(), 0);
+                              return f.numRegions() + f.volume()->cells();
+                          });
+}
+
+}  // namespace
+}  // namespace rlpbrt::guiding
