@@ -32,7 +32,8 @@ Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n, float smallScale) {
 PathIntegrator::PathIntegrator(const Scene& scene, const GuideSettings& guide)
     : scene_(scene),
       lights_(createLightSampler(scene.integrator.lightSampleStrategy, scene.lights,
-                                 scene.boundsMin(), scene.boundsMax(), nullptr)),
+                                 scene.boundsMin(), scene.boundsMax(), nullptr,
+                                 scene.hasMedia())),
       guide_(guide), maxDepth_(scene.integrator.maxDepth),
       rrThreshold_(scene.integrator.rrThreshold) {
     guide_.mix = clamp(guide_.mix, 0.f, 1.f);
@@ -323,7 +324,8 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
                                                 PathRecorder& rec) const {
     // Free flight to the surface (or to infinity) through the current medium.
     const Medium& medium = *scene_.media[size_t(s.pm.medium)];
-    MediumSample ms = medium.sample(s.ray.o, s.ray.d, found ? si.t : s.ray.tMax, *s.pm.rng);
+    MediumSample ms = medium.sample(s.ray.o, s.ray.d, found ? si.t : s.ray.tMax,
+                                    sampler.get2D(), *s.pm.rng);
     s.beta *= ms.weight;
     if (isBlack(s.beta) || !isFinite(s.beta)) return Step::End;
     // The pending target is radiance arriving at its vertex: weighted by the flight.

@@ -2,7 +2,7 @@
 //  - "uniform": every light equally likely;
 //  - "power": proportional to emitted power;
 //  - "spatial" (pbrt-v3's default): a voxel grid over the scene bounds (64 voxels along the
-//    longest axis as pbrt-v3 with more than 8 lights, 16 with fewer); each voxel, the first
+//    longest axis as pbrt-v3 with more than 8 lights or with media, 16 otherwise); each voxel, the first
 //    time a point in it asks, estimates every light's contribution at 128 points inside it
 //    (luminance of Li / pdf, no visibility) and samples lights proportionally, with a floor
 //    of 0.1% of the average so that no light has zero probability.
@@ -28,11 +28,12 @@ public:
 };
 
 // Creates the sampler for a strategy name; unknown names fall back to "spatial" with a
-// message in *note.
+// message in *note. media: the scene has participating media (medium vertices fill the
+// volume between surfaces; "spatial" then keeps pbrt-v3's 64 voxels for any light count).
 std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,
                                                  const std::vector<std::unique_ptr<Light>>& lights,
                                                  const Vec3& boundsMin, const Vec3& boundsMax,
-                                                 std::string* note);
+                                                 std::string* note, bool media = false);
 
 // The "spatial" strategy, exposed for tests.
 class SpatialLightSampler : public LightSampler {

@@ -49,11 +49,13 @@ Spectrum HomogeneousMedium::tr(const Vec3&, const Vec3&, float tMax, Rng&) const
     return expNeg(sigmaT_, tMax);
 }
 
-MediumSample HomogeneousMedium::sample(const Vec3&, const Vec3&, float tMax, Rng& rng) const {
-    // pbrt-v3: pick a channel uniformly, sample exp(-sigma_t[c] t), and divide by the
-    // average over channels of the per-channel densities (single-sample spectral MIS).
-    int channel = std::min(int(rng.uniform() * 3.f), 2);
-    float dist = -std::log(1.f - rng.uniform()) / sigmaT_[channel];
+MediumSample HomogeneousMedium::sample(const Vec3&, const Vec3&, float tMax, Vec2 u,
+                                       Rng&) const {
+    // pbrt-v3: pick a channel uniformly (u.x), sample exp(-sigma_t[c] t) (u.y), and divide
+    // by the average over channels of the per-channel densities (single-sample spectral
+    // MIS). Both come from the pixel sampler, stratified like pbrt-v3's two Get1D() calls.
+    int channel = std::min(int(u.x * 3.f), 2);
+    float dist = -std::log(1.f - u.y) / sigmaT_[channel];
     float t = std::min(dist, tMax);
     MediumSample ms;
     ms.scattered = t < tMax;

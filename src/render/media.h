@@ -70,7 +70,11 @@ class Medium {
 public:
     virtual ~Medium();
     // Free flight along o + t d (d unit), t in (0, tMax]: a scattering event or passage.
-    virtual MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const = 0;
+    // u: two of the pixel sampler's dimensions, used by media whose flights take a fixed
+    // number of decisions (homogeneous: the channel, then the distance, as pbrt-v3's
+    // HomogeneousMedium::Sample draws two 1D samples); tracking media use rng.
+    virtual MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Vec2 u,
+                                Rng& rng) const = 0;
     // Unbiased estimate of the transmittance of the segment o + t d, t in (0, tMax].
     virtual Spectrum tr(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const = 0;
     float g() const { return g_; }
@@ -85,7 +89,8 @@ protected:
 class HomogeneousMedium final : public Medium {
 public:
     HomogeneousMedium(const Spectrum& sigmaA, const Spectrum& sigmaS, float g);
-    MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const override;
+    MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Vec2 u,
+                        Rng& rng) const override;
     Spectrum tr(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const override;
 
 private:
@@ -177,7 +182,8 @@ public:
     using DensityMediumBase::DensityMediumBase;
 
     // Delta tracking (pbrt-v3 GridDensityMedium::Sample, with a majorant per cell).
-    MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Rng& rng) const override {
+    MediumSample sample(const Vec3& o, const Vec3& d, float tMax, Vec2,
+                        Rng& rng) const override {
         MediumSample ms;
         Vec3 oL, dL;
         float t0, t1;

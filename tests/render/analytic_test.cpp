@@ -197,6 +197,40 @@ std::string foggyEnclosure(double sigmaS, double g, double Le) {
            "WorldEnd\n";
 }
 
+// Light from outside a bounded medium: a homogeneous fog (sigma_a, sigma_s, g) fills a
+// null-material sphere of radius 1 (pbrt-v3's Material "" with a MediumInterface), inside a
+// vacuum enclosure of radius 2 whose black walls emit Le, as two hemispheres (two area lights,
+// so the spatial light sampler chooses between them at every medium vertex). The camera sits
+// at the centre, inside the fog (cameraInside), or in the vacuum at z = 1.6 looking at the
+// fog sphere. Every path leaves the fog through the null boundary and ends on the wall, so
+// with sigma_a = 0 the answer is Le everywhere; with sigma_s = 0 it is Le exp(-sigma_a l),
+// l the chord the camera ray runs through the fog (1 from the centre).
+std::string boundedFog(double sigmaA, double sigmaS, double g, double Le, bool cameraInside) {
+    const std::string a = num(sigmaA), s = num(sigmaS), l = num(Le);
+    const std::string wall = "AreaLightSource \"diffuse\" \"rgb L\" [" + l + " " + l + " " + l +
+                             "]\nMaterial \"matte\" \"rgb Kd\" [0 0 0]\nReverseOrientation\n"
+                             "Shape \"sphere\" \"float radius\" 2 \"float phimax\" 180\n";
+    return "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [" + a +
+           " " + a + " " + a + "] \"rgb sigma_s\" [" + s + " " + s + " " + s +
+           "] \"float g\" " + num(g) + "\n" +
+           (cameraInside ? "MediumInterface \"\" \"fog\"\nLookAt 0 0 0  0 0 -1  0 1 0\n"
+                         : "LookAt 0 0 1.6  0 0 0  0 1 0\n") +
+           "Camera \"perspective\" \"float fov\" " + (cameraInside ? "60" : "20") + "\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"volpath\" \"integer maxdepth\" 1000\n"
+           "WorldBegin\n"
+           "AttributeBegin\n"
+           "MediumInterface \"fog\" \"\"\n"
+           "Material \"\"\n"
+           "Shape \"sphere\" \"float radius\" 1\n"
+           "AttributeEnd\n"
+           "AttributeBegin\n" + wall + "AttributeEnd\n"
+           "AttributeBegin\nRotate 180 0 0 1\n" + wall + "AttributeEnd\n"
+           "WorldEnd\n";
+}
+
 const char* kBackends[] = {"none", "hemi", "vdb"};
 
 class Analytic : public ::testing::TestWithParam<const char*> {};
@@ -324,6 +358,22 @@ TEST_P(Analytic, LosslessMediumInEmittingEnclosure) {
         for (double g : {0.0, 0.8})
             expectMean(renderText(foggyEnclosure(sigmaS, g, 1.0), GetParam()), 1.0,
                        "fog sigma_s " + num(sigmaS) + " g " + num(g));
+}
+
+// Radiance from lights outside a bounded medium, seen through its null-material boundary
+// (issue 33): next-event estimation from medium vertices crosses the boundary, and so do the
+// camera rays. Lossless fog (thin and thick, isotropic and forward scattering) conserves Le;
+// a purely absorbing one gives exp(-sigma_a) from the centre.
+TEST_P(Analytic, LightFromOutsideABoundedMedium) {
+    for (bool inside : {true, false})
+        for (double sigmaS : {0.5, 3.0})
+            for (double g : {0.0, 0.7})
+                expectMean(renderText(boundedFog(0.0, sigmaS, g, 1.0, inside), GetParam()),
+                           1.0,
+                           std::string(inside ? "inside" : "outside") + " sigma_s " +
+                               num(sigmaS) + " g " + num(g));
+    expectMean(renderText(boundedFog(0.7, 0.0, 0.0, 1.0, true), GetParam()), std::exp(-0.7),
+               "absorbing fog");
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Analytic, ::testing::ValuesIn(kBackends));

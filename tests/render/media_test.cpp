@@ -120,7 +120,7 @@ TEST(HomogeneousMedium, FreeFlightWeightsAreUnbiased) {
     const float d = 1.3f;
     MeanVar pass[3], scat[3];
     for (int i = 0; i < 400000; ++i) {
-        MediumSample s = m.sample(Vec3(0.f), Vec3(0, 1, 0), d, rng);
+        MediumSample s = m.sample(Vec3(0.f), Vec3(0, 1, 0), d, Vec2(rng.uniform(), rng.uniform()), rng);
         for (int c = 0; c < 3; ++c) {
             pass[c].add(s.scattered ? 0.0 : s.weight[c]);
             scat[c].add(s.scattered ? s.weight[c] : 0.0);
@@ -203,7 +203,7 @@ TEST_P(GridTracking, TrackersMatchAnalyticTransmittance) {
     MeanVar ratio, delta, scatterWeight;
     for (int i = 0; i < 200000; ++i) {
         ratio.add(m.tr(o, dir, tMax, rng)[0]);
-        MediumSample s = m.sample(o, dir, tMax, rng);
+        MediumSample s = m.sample(o, dir, tMax, Vec2(rng.uniform(), rng.uniform()), rng);
         delta.add(s.scattered ? 0.0 : 1.0);
         if (s.scattered) {
             ASSERT_LT(s.t, tMax);
@@ -244,7 +244,7 @@ TEST(GridMedium, RayMissingTheBoxIsUnattenuated) {
     GridMedium m(Spectrum(1.f), Spectrum(1.f), 0.f, Mat4(1.f), 1, 1, 1, {1.f});
     Rng rng(3);
     EXPECT_EQ(m.tr(Vec3(2, 2, 2), Vec3(1, 0, 0), 10.f, rng), Spectrum(1.f));
-    EXPECT_FALSE(m.sample(Vec3(2, 2, 2), Vec3(1, 0, 0), 10.f, rng).scattered);
+    EXPECT_FALSE(m.sample(Vec3(2, 2, 2), Vec3(1, 0, 0), 10.f, Vec2(0.5f), rng).scattered);
     // Segment ending before the box.
     EXPECT_EQ(m.tr(Vec3(-5, 0.5f, 0.5f), Vec3(1, 0, 0), 4.f, rng), Spectrum(1.f));
 }

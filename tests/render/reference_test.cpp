@@ -69,7 +69,7 @@ const char* kSurfaceScenes[] = {
 const char* kGuides[] = {"none", "hemi", "vdb"};
 
 // The scenes with participating media (manifest media=1): the same test, same bounds.
-const char* kMediaScenes[] = {"cloud__cloud"};
+const char* kMediaScenes[] = {"cloud__cloud", "volume-boundary__boundary"};
 
 class ReferenceTest
     : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
