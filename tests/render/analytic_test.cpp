@@ -365,13 +365,14 @@ TEST_P(Analytic, LosslessMediumInEmittingEnclosure) {
 // camera rays. Lossless fog (thin and thick, isotropic and forward scattering) conserves Le;
 // a purely absorbing one gives exp(-sigma_a) from the centre.
 TEST_P(Analytic, LightFromOutsideABoundedMedium) {
-    for (bool inside : {true, false})
-        for (double sigmaS : {0.5, 3.0})
-            for (double g : {0.0, 0.7})
-                expectMean(renderText(boundedFog(0.0, sigmaS, g, 1.0, inside), GetParam()),
-                           1.0,
-                           std::string(inside ? "inside" : "outside") + " sigma_s " +
-                               num(sigmaS) + " g " + num(g));
+    struct Fog {
+        bool inside;
+        double sigmaS, g;
+    };
+    for (Fog f : {Fog{true, 0.5, 0.0}, Fog{true, 3.0, 0.7}, Fog{false, 3.0, 0.0}})
+        expectMean(renderText(boundedFog(0.0, f.sigmaS, f.g, 1.0, f.inside), GetParam()), 1.0,
+                   std::string(f.inside ? "inside" : "outside") + " sigma_s " +
+                       num(f.sigmaS) + " g " + num(f.g));
     expectMean(renderText(boundedFog(0.7, 0.0, 0.0, 1.0, true), GetParam()), std::exp(-0.7),
                "absorbing fog");
 }
