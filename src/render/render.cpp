@@ -113,8 +113,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // (1, 1, 1, 1, 2, 3, 4, 6, 9, ...; at most 64): frequent updates early. Its samples
     // continue the same sequence per pixel, or (samples=independent, GuideSettings::
     // independentPasses) come from a set of the pass's own (Sampler::passSampler).
-    // Measured at 64 spp (relMSE, hemi): doubling pass sizes gave veach-bidir 0.382 /
-    // breakfast 4.73 against 0.345 / 4.46 with halves (independent sets).
+    // Halves learned better than doubling pass sizes (docs/BENCHMARKS_HISTORY.md).
     bool guided = field != nullptr;
     constexpr int kMaxGuidedPass = 64;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
@@ -149,9 +148,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // Adjoint-driven roulette's pixel estimates (PathIntegrator::wantsPixelEstimate),
     // refreshed after every guided pass once they average kRouletteMinSpp samples per pixel
     // (until then they stay 0 and the integrator plays pbrt-v3's roulette). Estimates from
-    // fewer samples made the roulette cost time on short renders: 16 spp, two threads, seeds
-    // 2-9, relMSE and seconds: breakfast 9.56 / 1.68 s -> 9.46 / 1.54 s (none: 9.50 /
-    // 1.40 s), cornell-box 0.003341 / 0.92 s -> 0.003338 / 0.85 s; at 64 spp unchanged.
+    // fewer samples made the roulette cost time on short renders (docs/GUIDING.md, `rr`).
     constexpr int kRouletteMinSpp = 8;
     PixelEstimates estimates(film.pixelBounds());
     // The tiles' sums exchanged after each pass: every rank needs the whole film when the
