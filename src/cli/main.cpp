@@ -362,6 +362,21 @@ int main(int argc, char** argv) {
             j["guide_mix"] = mix;
             if (guide == "vdb") j["guide_active_voxels"] = gs.activeVoxels;
             j["guide_learned_regions"] = gs.learnedRegions;
+            // Guiding's cost (render/guide_clock.h): the guide's time per vertex with a guide,
+            // from the timed paths; the updates between passes; their share of the render's
+            // thread time.
+            const double nsPerVertex =
+                s.timedGuidedVertices ? s.guideClock.guideNanos() / double(s.timedGuidedVertices)
+                                      : 0.0;
+            const int threads =
+                nThreads > 0 ? nThreads : int(std::max(1u, std::thread::hardware_concurrency()));
+            j["guide_guided_vertices"] = s.guidedVertices;
+            j["guide_ns_per_guided_vertex"] = nsPerVertex;
+            j["guide_end_pass_seconds"] = r.guideEndPassSeconds;
+            j["guide_time_share"] =
+                r.seconds > 0.0 ? (nsPerVertex * 1e-9 * double(s.guidedVertices) / threads +
+                                   r.guideEndPassSeconds) / r.seconds
+                                : 0.0;
             if (gs.mediumCells) j["guide_medium_cells"] = gs.mediumCells;
             if (gs.selectionRegions) {
                 j["guide_selection_regions"] = gs.selectionRegions;

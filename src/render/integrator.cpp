@@ -201,7 +201,10 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
     float pGuide = 0.f, pBsdf = 0.f;
     if (uc < mix) {
         float uStratum = std::min(uc / mix, OneMinusEpsilon);
-        ds.wi = guide.guide.sample(u, uStratum, &pGuide, &ds.bin);
+        {
+            GuideTimer timer(guide.clock);
+            ds.wi = guide.guide.sample(u, uStratum, &pGuide, &ds.bin);
+        }
         if (!(pGuide > 0.f)) return DirectionSample();
         ds.f = bsdf.f(si.wo, ds.wi);
         pBsdf = bsdf.pdf(si.wo, ds.wi);
@@ -212,6 +215,7 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
         ds.wi = bs.wi;
         ds.f = bs.f;
         pBsdf = bs.pdf;
+        GuideTimer timer(guide.clock);
         pGuide = guide.guide.pdf(ds.wi, &ds.bin);
     }
     ds.pdf = mix * pGuide + (1.f - mix) * pBsdf;
@@ -280,13 +284,19 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
     ds.scale = guide.scale;
     float pGuide = 0.f, pPhase = 0.f;
     if (uc < mix) {
-        ds.wi = guide.guide.sample(u, std::min(uc / mix, OneMinusEpsilon), &pGuide, &ds.bin);
+        {
+            GuideTimer timer(guide.clock);
+            ds.wi = guide.guide.sample(u, std::min(uc / mix, OneMinusEpsilon), &pGuide, &ds.bin);
+        }
         if (!(pGuide > 0.f)) return DirectionSample();
         pPhase = henyeyGreenstein(glm::dot(wo, ds.wi), g);
     } else {
         ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
         if (!(pPhase > 0.f)) return DirectionSample();
-        if (mix > 0.f) pGuide = guide.guide.pdf(ds.wi, &ds.bin);
+        if (mix > 0.f) {
+            GuideTimer timer(guide.clock);
+            pGuide = guide.guide.pdf(ds.wi, &ds.bin);
+        }
     }
     ds.f = Spectrum(pPhase);
     ds.pdf = mix * pGuide + (1.f - mix) * pPhase;
@@ -329,7 +339,10 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     s.beta *= ms.weight;
     if (isBlack(s.beta) || !isFinite(s.beta)) return Step::End;
     // The pending target is radiance arriving at its vertex: weighted by the flight.
-    rec.flight(ms.weight);
+    {
+        GuideTimer timer(s.clock);
+        rec.flight(ms.weight);
+    }
     if (!ms.scattered) return Step::Surface;
     // A medium vertex: NEE with MIS against the direction sampling, then a direction from the
     // phase function, mixed with the guide where the field has a volume cell (the field is
@@ -338,17 +351,26 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     const Vec3 p = s.ray.o + ms.t * s.ray.d, wo = -s.ray.d;
     guiding::VertexGuide guide;
     if (guide_.field) {
+        GuideTimer timer(s.clock);
         guide = guide_.field->guide(guiding::VertexQuery::inMedium(p));
         if (!guide.valid()) rec.requestMedium(p);
     }
+    countGuided(guide, s.clock, stats);
     const guiding::VertexGuide sampleGuide = guide_.mix > 0.f ? guide : guiding::VertexGuide();
     ++stats.vertices;
     GuideMixture vertexGuide{sampleGuide, 1.f};
+    vertexGuide.clock = s.clock;
     s.L += s.beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, s.pm, sampler, stats);
     DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, sampler);
-    rec.mediumScattered(guide, ds);
+    {
+        GuideTimer timer(s.clock);
+        rec.mediumScattered(guide, ds);
+    }
     if (!(ds.pdf > 0.f)) return Step::End;
-    rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
+    {
+        GuideTimer timer(s.clock);
+        rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
+    }
     s.beta *= ds.f.x / ds.pdf;  // 1 for plain phase sampling
     s.dirPdf = ds.pdf;
     s.specularBounce = false;
@@ -428,6 +450,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     BSDF bsdf;
     guiding::GuidingField* field = guide_.field;
     PathRecorder rec(guide_, slot);
+    // One path in kGuideClockEvery measures the guide's time (render/guide_clock.h).
+    s.clock = field && stats.paths % kGuideClockEvery == 0 ? &stats.guideClock : nullptr;
     // Media (volpath): the medium the ray travels in; tracking decisions use a per-path
     // generator seeded from two sampler dimensions. Scenes without media skip all of it.
     const bool media = scene_.hasMedia();
@@ -458,6 +482,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // otherwise; the material evaluation runs in between).
         guiding::VertexQuery query;
         if (found && wantsRegion) {
+            GuideTimer timer(s.clock);
             query.p = si.p;
             if (guide_.patches) query.patch = guide_.patches->key(si);
             field->prefetch(query);
@@ -487,6 +512,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                     s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
                 }
             }
+            GuideTimer timer(s.clock);
             rec.escaped(envLum);
             break;
         }
@@ -511,7 +537,10 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // shadow rays stop at them.)
         if (si.material < 0) {
             if ((bounces >= maxDepth_ && !media) || ++passThroughs > 256) break;
-            rec.passedThrough(emitted);
+            {
+                GuideTimer timer(s.clock);
+                rec.passedThrough(emitted);
+            }
             if (media) s.pm.medium = si.mediumAfter(s.ray.d, s.pm.medium);
             s.ray.o = spawnOrigin(si, s.ray.d, originScale_);
             --bounces;
@@ -527,14 +556,17 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         const bool canGuide = field && guidable(lobes);
         guiding::VertexGuide guide;
         if (canGuide && wantsRegion) {
+            GuideTimer timer(s.clock);
             query.n = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
             guide = field->guide(query);
         }
+        countGuided(guide, s.clock, stats);
         const bool lastVertex = bounces >= maxDepth_;
         const float share =
             guide.valid() && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
         const guiding::VertexGuide sampleGuide = share > 0.f ? guide : guiding::VertexGuide();
         GuideMixture vertexGuide{sampleGuide, share};
+        vertexGuide.clock = s.clock;
 
         // Next-event estimation at non-specular vertices (first: its shadow ray gives the
         // guide's prefetch of the region's tables time to land).
@@ -545,21 +577,34 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                                             media ? &s.pm : nullptr);
         }
         // Training: the previous guided vertex's Eq. 1 target, from the light found here.
-        const bool deferTarget =
-            rec.surfaceReached(si, bsdf, guide, canGuide, lobes.all, emitted, lastVertex);
+        bool deferTarget;
+        {
+            GuideTimer timer(s.clock);
+            deferTarget =
+                rec.surfaceReached(si, bsdf, guide, canGuide, lobes.all, emitted, lastVertex);
+        }
         if (lastVertex) break;
 
         // The next direction (the guiding seam), and what the guide learns from it.
         DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
-        rec.surfaceSampled(deferTarget, si, guide, ds, emitted);
+        {
+            GuideTimer timer(s.clock);
+            rec.surfaceSampled(deferTarget, si, guide, ds, emitted);
+        }
         if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
-        rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
+        {
+            GuideTimer timer(s.clock);
+            rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
+        }
         const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
         s.beta *= weight;
         s.dirPdf = ds.pdf;
         s.specularBounce = ds.specular;
-        rec.surfaceScattered(guide, !ds.transmission && !lastDirection, canGuide, ds, weight,
-                             s.L, s.beta);
+        {
+            GuideTimer timer(s.clock);
+            rec.surfaceScattered(guide, !ds.transmission && !lastDirection, canGuide, ds, weight,
+                                 s.L, s.beta);
+        }
 
         // The next ray.
         if (ds.specular && ds.transmission) {
@@ -582,8 +627,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
             sampleGuide.valid() && !ds.transmission &&
             guideConfidence(vertexGuide) >= kRouletteConfidence) {
-            const float expected =
-                luminance(s.beta) * sampleGuide.policyRadiance(ds.wi, ds.bin);
+            float expected;
+            {
+                GuideTimer timer(s.clock);
+                expected = luminance(s.beta) * sampleGuide.policyRadiance(ds.wi, ds.bin);
+            }
             if (!adjointRoulette(&s.beta, expected, guide_.rouletteWindow * pixelEstimate,
                                  kMinSurvival, sampler))
                 break;
@@ -591,7 +639,10 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) break;
     }
-    rec.finish(s.L);
+    {
+        GuideTimer timer(s.clock);
+        rec.finish(s.L);
+    }
     return s.L;
 }
 

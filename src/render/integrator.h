@@ -8,6 +8,7 @@
 
 #include "guiding/guiding.h"
 #include "render/direction_sample.h"
+#include "render/guide_clock.h"
 #include "render/light_sampler.h"
 #include "render/patches.h"
 #include "render/ray.h"
@@ -22,12 +23,20 @@ struct PathStats {
     uint64_t vertices = 0;           // surface scattering vertices (path length sum)
     uint64_t zeroRadiancePaths = 0;  // camera paths that carried no light
     uint64_t nonFinite = 0;          // samples dropped because they were NaN/Inf
+    // Guiding's cost (render/guide_clock.h): vertices whose region had a guide, and on the
+    // timed paths (one in kGuideClockEvery) those vertices and the time spent in the guide.
+    uint64_t guidedVertices = 0;
+    uint64_t timedGuidedVertices = 0;
+    GuideClockSums guideClock;
     void add(const PathStats& o) {
         paths += o.paths;
         rays += o.rays;
         vertices += o.vertices;
         zeroRadiancePaths += o.zeroRadiancePaths;
         nonFinite += o.nonFinite;
+        guidedVertices += o.guidedVertices;
+        timedGuidedVertices += o.timedGuidedVertices;
+        guideClock.add(o.guideClock);
     }
 };
 
@@ -125,6 +134,7 @@ private:
         float mix = -1.f;         // the guide probability: selection x scale, once found
         float confidence = 0.f;   // the region's
         float scale = 0.f;        // confidence x share
+        GuideClockSums* clock = nullptr;  // the path's guide clock (render/guide_clock.h), if timed
     };
     float guideMix(GuideMixture& g) const {
         if (g.mix < 0.f) {
@@ -142,7 +152,16 @@ private:
     float mixturePdf(GuideMixture& g, const Vec3& wi, float otherPdf) const {
         if (!g.guide.valid()) return otherPdf;
         const float mix = guideMix(g);
-        return mix > 0.f ? mix * g.guide.pdf(wi) + (1.f - mix) * otherPdf : otherPdf;
+        if (!(mix > 0.f)) return otherPdf;
+        GuideTimer timer(g.clock);
+        return mix * g.guide.pdf(wi) + (1.f - mix) * otherPdf;
+    }
+    // PathStats' count of guided vertices (and of those on timed paths).
+    static void countGuided(const guiding::VertexGuide& g, const GuideClockSums* clock,
+                            PathStats& stats) {
+        if (!g.valid()) return;
+        ++stats.guidedVertices;
+        if (clock) ++stats.timedGuidedVertices;
     }
     float guideConfidence(GuideMixture& g) const {
         guideMix(g);
@@ -188,6 +207,7 @@ private:
         float dirPdf = 0.f, etaScale = 1.f;
         LightSampleContext prev;
         PathMedium pm;
+        GuideClockSums* clock = nullptr;  // the guide clock of a timed path (render/guide_clock.h)
     };
     // The medium step of Li (scenes with media, a path in a medium): the free flight to the
     // closest hit si (found: there is one), and at a scattering event the medium vertex (NEE,

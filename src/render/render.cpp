@@ -270,10 +270,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         });
         // The guide learns between passes: every pass samples from a frozen policy.
         if (learningPass) {
+            const double endStart = now();
             if (ranks)
                 field->endPassShared(sumAcross);
             else
                 field->endPass();
+            result.guideEndPassSeconds += now() - endStart;
         }
         const double secondsPerSample =
             (cpuNow() - passStart) / (double(pixelsPerPass) * double(count));
@@ -345,11 +347,20 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     result.passes = pass;
     if (ranks) {
         PathStats& s = result.stats;
-        double sums[5] = {double(s.paths), double(s.rays), double(s.vertices),
-                          double(s.zeroRadiancePaths), double(s.nonFinite)};
-        ranks->sumDoubles(sums, 5);
+        double sums[9] = {double(s.paths),
+                          double(s.rays),
+                          double(s.vertices),
+                          double(s.zeroRadiancePaths),
+                          double(s.nonFinite),
+                          double(s.guidedVertices),
+                          double(s.timedGuidedVertices),
+                          double(s.guideClock.nanos),
+                          double(s.guideClock.calls)};
+        ranks->sumDoubles(sums, 9);
         s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]), s.vertices = uint64_t(sums[2]);
         s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
+        s.guidedVertices = uint64_t(sums[5]), s.timedGuidedVertices = uint64_t(sums[6]);
+        s.guideClock.nanos = uint64_t(sums[7]), s.guideClock.calls = uint64_t(sums[8]);
         result.ranks = ranks->size();
         result.bytesExchanged = ranks->bytesExchanged();
         result.secondsExchanging = ranks->secondsExchanging() - exchangeBefore;

@@ -37,6 +37,8 @@ struct RenderResult {
     bool cancelled = false;
     // Samples per pixel rendered while the guide learned (learn=N; all guided ones without).
     int learningSpp = 0;
+    // Wall seconds of the guide's updates between passes (GuidingField::endPass).
+    double guideEndPassSeconds = 0.0;
     // The auto trial of a guided render (GuideSettings::autoSpp): whether it ran, its verdict,
     // the spp at which guiding stopped (= spp if it never did), and the two passes' costs
     // (relative variance per sample x CPU seconds per sample).

@@ -126,6 +126,45 @@ TEST(GuideFileCli, TheTrialRunsWhenAsked) {
     rmdir(dir.c_str());
 }
 
+// --stats reports guiding's cost (render/guide_clock.h): vertices with a guide, the guide's
+// time per such vertex from the timed paths, the updates between passes and the share of the
+// render; a plain render has none of these.
+double number(const std::string& json, const std::string& key) {
+    const size_t at = json.find("\"" + key + "\": ");
+    if (at == std::string::npos) return -1.0;
+    return std::stod(json.substr(at + key.size() + 4));
+}
+
+TEST(GuideFileCli, StatsReportTheGuidesCost) {
+    char tmpl[] = "/tmp/rlpbrt-guidecost-XXXXXX";
+    const std::string dir = mkdtemp(tmpl) ? tmpl : "/tmp";
+    const std::string scene = writeScene(dir + "/a.pbrt", false);
+    const std::string stats = dir + "/s.json";
+    const std::string a = scene + " --spp 16 --nthreads 1 --quiet -o " + dir + "/out.exr --stats " +
+                          stats + " ";
+    for (const char* g : {"hemi", "vdb"}) {
+        CliRun guided = run(a + "--guide=" + g);
+        ASSERT_EQ(guided.status, 0) << guided.output;
+        const std::string json = slurp(stats);
+        const double vertices = number(json, "guide_guided_vertices");
+        const double all = number(json, "mean_path_length") * number(json, "paths");
+        EXPECT_GT(vertices, 0.0) << g << json;
+        EXPECT_LE(vertices, all + 0.5) << g << json;  // one surface vertex has one lookup
+        const double ns = number(json, "guide_ns_per_guided_vertex");
+        EXPECT_GT(ns, 0.0) << g << json;
+        EXPECT_LT(ns, 1e6) << g << json;  // a lookup and a sample take ns to us, never a ms
+        EXPECT_GT(number(json, "guide_end_pass_seconds"), 0.0) << g << json;
+        const double share = number(json, "guide_time_share");
+        EXPECT_GT(share, 0.0) << g << json;
+        EXPECT_LT(share, 1.0) << g << json;
+    }
+    CliRun plain = run(a + "--guide=none");
+    ASSERT_EQ(plain.status, 0) << plain.output;
+    EXPECT_EQ(slurp(stats).find("guide_ns_per_guided_vertex"), std::string::npos);
+    for (const char* f : {"a.pbrt", "out.exr", "s.json"}) std::remove((dir + "/" + f).c_str());
+    rmdir(dir.c_str());
+}
+
 // learn=N: the guide learns in the first N spp only (a render of N spp saves the same field
 // as one of more spp with learn=N), learn=0 renders with a loaded field and leaves it as it
 // was, --stats reports the learning spp, and bad values are errors.
