@@ -13,7 +13,10 @@
 # commas for spaces), default none, hemi, vdb and one variation of each main parameter.
 # Writes OUTDIR/<scene>__<config>.{csv,json,log} and the images, <scene>__<config>.exr, to
 # $IMAGES (default bench/out/<OUTDIR's name>, ignored by git: images stay out of the tracked
-# tree); bench/curves_report.py summarises them.
+# tree); bench/curves_report.py summarises them. MANIFEST: another table of scenes with the
+# manifest's columns (default ../shared/references/manifest.tsv); a row with a 12th column,
+# the reference's path, is one of our own scenes (bench/study-scenes.tsv): its scene and
+# reference paths are relative to the repository.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 shared=${SHARED:-${RLPBRT_SHARED:-$here/../shared}}
@@ -45,8 +48,12 @@ threads=1
     echo "images: $images"
 } > "$out/run.txt"
 
-tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media; do
+manifest=${MANIFEST:-$shared/references/manifest.tsv}
+tail -n +2 "$manifest" | while IFS=$'\t' read -r id scene w h rspp rs rsec s64 rel64 bb64 media ownref; do
     [ $# -gt 0 ] && [[ "$want" != *" $id "* ]] && continue
+    scenefile=$shared/scenes/$scene
+    ref=$shared/references/$id.exr
+    if [ -n "${ownref:-}" ]; then scenefile=$here/$scene; ref=$here/$ownref; fi
     pids=()
     k=0
     for cfg in $configs; do
@@ -56,8 +63,8 @@ tail -n +2 "$shared/references/manifest.tsv" | while IFS=$'\t' read -r id scene 
         pin=()
         [ "${PIN:-0}" = 1 ] && pin=(taskset -c $((k % $(nproc))))
         k=$((k + 1))
-        "${pin[@]}" "$bin" "$shared/scenes/$scene" --time "$secs" --nthreads "$threads" --quiet ${args//,/ } \
-            --ref "$shared/references/$id.exr" --curve "$out/${id}__$name.csv" \
+        "${pin[@]}" "$bin" "$scenefile" --time "$secs" --nthreads "$threads" --quiet ${args//,/ } \
+            --ref "$ref" --curve "$out/${id}__$name.csv" \
             --stats "$out/${id}__$name.json" -o "$images/${id}__$name.exr" \
             > /dev/null 2> "$out/${id}__$name.log" &
         if [ "$sequential" = 1 ]; then
