@@ -231,6 +231,40 @@ std::string boundedFog(double sigmaA, double sigmaS, double g, double Le, bool c
            "WorldEnd\n";
 }
 
+// The depth limit at a medium interface (issue 33): a vacuum-like medium (all coefficients 0,
+// so volpath runs its media code) around the camera at the centre, a constant sky L outside,
+// and, with `boundary`, a null-material sphere of radius 1 around both (pbrt-v3's interface-
+// only shape). `material` (if any) is a disk of radius 0.5 at z = -0.5 facing the camera,
+// which looks at it (-z), or away from it (+z) with `lookAway`. pbrt-v3's volpath tests
+// maxdepth before it skips an interface, so light beyond the interface that a path at the
+// depth limit would count at full weight (camera ray, specular chain) ends there; next-event
+// estimation's BSDF-sampled share still crosses it (EstimateDirect traces through
+// interfaces), so a matte disk keeps rho L at maxdepth 1.
+std::string interfaceAtDepthLimit(const std::string& material, int maxDepth, bool boundary,
+                                  double L, bool lookAway = false) {
+    const std::string l = num(L);
+    return "MakeNamedMedium \"void\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0 0 0] "
+           "\"rgb sigma_s\" [0 0 0]\n"
+           "MediumInterface \"\" \"void\"\n" +
+           std::string(lookAway ? "LookAt 0 0 0  0 0 1  0 1 0\n" : "LookAt 0 0 0  0 0 -1  0 1 0\n") +
+           "Camera \"perspective\" \"float fov\" 20\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"volpath\" \"integer maxdepth\" " + std::to_string(maxDepth) + "\n"
+           "WorldBegin\n"
+           "MediumInterface \"\" \"\"\n"
+           "LightSource \"infinite\" \"rgb L\" [" + l + " " + l + " " + l + "]\n" +
+           (boundary ? "AttributeBegin\nMediumInterface \"void\" \"\"\nMaterial \"\"\n"
+                       "Shape \"sphere\" \"float radius\" 1\nAttributeEnd\n"
+                     : "") +
+           (material.empty() ? ""
+                             : "AttributeBegin\nMaterial " + material +
+                                   "\nTranslate 0 0 -0.5\nShape \"disk\" \"float radius\" 0.5\n"
+                                   "AttributeEnd\n") +
+           "WorldEnd\n";
+}
+
 const char* kBackends[] = {"none", "hemi", "vdb"};
 
 class Analytic : public ::testing::TestWithParam<const char*> {};
@@ -375,6 +409,29 @@ TEST_P(Analytic, LightFromOutsideABoundedMedium) {
                        num(f.sigmaS) + " g " + num(f.g));
     expectMean(renderText(boundedFog(0.7, 0.0, 0.0, 1.0, true), GetParam()), std::exp(-0.7),
                "absorbing fog");
+}
+
+// pbrt-v3's depth limit at a null-material interface (issue 33): the interface ends a path
+// that reaches it at maxdepth where the light beyond would count at full weight (after a
+// specular bounce, or the camera ray at maxdepth 0), and only there. volume-boundary's glass
+// sphere at the fifth vertex, seen through the fog, made rlpbrt's mean 0.17% brighter than
+// pbrt-v3's when the interface let such paths through.
+TEST_P(Analytic, InterfaceAtTheDepthLimit) {
+    const std::string mirror = "\"mirror\" \"rgb Kr\" [1 1 1]";
+    const std::string matte = "\"matte\" \"rgb Kd\" [0.6 0.6 0.6]";
+    const double L = 2.0;
+    expectMean(renderText(interfaceAtDepthLimit(mirror, 1, true, L), GetParam()), 0.0,
+               "mirror, maxdepth 1: the reflection ends at the interface");
+    expectMean(renderText(interfaceAtDepthLimit(mirror, 2, true, L), GetParam()), L,
+               "mirror, maxdepth 2: the reflection crosses the interface");
+    expectMean(renderText(interfaceAtDepthLimit(mirror, 1, false, L), GetParam()), L,
+               "mirror, maxdepth 1, no interface");
+    expectMean(renderText(interfaceAtDepthLimit(matte, 1, true, L), GetParam()), 0.6 * L,
+               "matte, maxdepth 1: next-event estimation crosses the interface");
+    expectMean(renderText(interfaceAtDepthLimit("", 0, true, L, true), GetParam()), 0.0,
+               "camera ray at maxdepth 0 ends at the interface");
+    expectMean(renderText(interfaceAtDepthLimit("", 0, false, L, true), GetParam()), L,
+               "camera ray at maxdepth 0, no interface");
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Analytic, ::testing::ValuesIn(kBackends));
