@@ -537,7 +537,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         // path always (its shadow rays stop at boundaries too); volpath where the light
         // beyond would count at full weight (the camera ray, after a specular bounce). After a
         // non-specular vertex the ray goes on for its MIS-weighted share, which volpath's
-        // next-event estimation finds through boundaries. docs/MEDIA.md, "Depth limit".
+        // next-event estimation finds through boundaries (docs/MEDIA.md, "Depth limit
+        // at medium boundaries").
         if (si.material < 0) {
             const bool fullWeight = bounces == 0 || s.specularBounce;
             if ((bounces >= maxDepth_ && (!media || fullWeight)) || ++passThroughs > 256) break;
