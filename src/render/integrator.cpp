@@ -532,11 +532,16 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             }
         }
 
-        // Medium boundaries without a surface: continue the ray unchanged. (With media, as
-        // volpath, light found through boundaries after the last vertex still counts; path's
-        // shadow rays stop at them.)
+        // Medium boundaries without a surface: continue the ray unchanged. At the depth
+        // limit, pbrt-v3 ends the path here (it tests maxdepth before it skips a boundary):
+        // path always (its shadow rays stop at boundaries too); volpath where the light
+        // beyond would count at full weight (the camera ray, after a specular bounce). After a
+        // non-specular vertex the ray goes on for its MIS-weighted share, which volpath's
+        // next-event estimation finds through boundaries (docs/MEDIA.md, "Depth limit
+        // at medium boundaries").
         if (si.material < 0) {
-            if ((bounces >= maxDepth_ && !media) || ++passThroughs > 256) break;
+            const bool fullWeight = bounces == 0 || s.specularBounce;
+            if ((bounces >= maxDepth_ && (!media || fullWeight)) || ++passThroughs > 256) break;
             {
                 GuideTimer timer(s.clock);
                 rec.passedThrough(emitted);

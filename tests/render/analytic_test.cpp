@@ -15,6 +15,7 @@
 
 #include "parser/diagnostics.h"
 #include "render/image.h"
+#include "render/image_io.h"
 #include "render/metrics.h"
 #include "render/render.h"
 #include "render/scene.h"
@@ -231,6 +232,71 @@ std::string boundedFog(double sigmaA, double sigmaS, double g, double Le, bool c
            "WorldEnd\n";
 }
 
+// The depth limit at a medium interface (issue 33): a vacuum-like medium (all coefficients 0,
+// so volpath runs its media code) around the camera at the centre, a constant sky L outside,
+// and, with `boundary`, a null-material sphere of radius 1 around both (pbrt-v3's interface-
+// only shape). `material` (if any) is a disk of radius 0.5 at z = -0.5 facing the camera,
+// which looks at it (-z), or away from it (+z) with `lookAway`. pbrt-v3's volpath tests
+// maxdepth before it skips an interface, so light beyond the interface that a path at the
+// depth limit would count at full weight (camera ray, specular chain) ends there; next-event
+// estimation's BSDF-sampled share still crosses it (EstimateDirect traces through
+// interfaces), so a matte disk keeps rho L at maxdepth 1.
+std::string interfaceAtDepthLimit(const std::string& material, int maxDepth, bool boundary,
+                                  double L, bool lookAway = false) {
+    const std::string l = num(L);
+    return "MakeNamedMedium \"void\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0 0 0] "
+           "\"rgb sigma_s\" [0 0 0]\n"
+           "MediumInterface \"\" \"void\"\n" +
+           std::string(lookAway ? "LookAt 0 0 0  0 0 1  0 1 0\n" : "LookAt 0 0 0  0 0 -1  0 1 0\n") +
+           "Camera \"perspective\" \"float fov\" 20\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"volpath\" \"integer maxdepth\" " + std::to_string(maxDepth) + "\n"
+           "WorldBegin\n"
+           "MediumInterface \"\" \"\"\n"
+           "LightSource \"infinite\" \"rgb L\" [" + l + " " + l + " " + l + "]\n" +
+           (boundary ? "AttributeBegin\nMediumInterface \"void\" \"\"\nMaterial \"\"\n"
+                       "Shape \"sphere\" \"float radius\" 1\nAttributeEnd\n"
+                     : "") +
+           (material.empty() ? ""
+                             : "AttributeBegin\nMaterial " + material +
+                                   "\nTranslate 0 0 -0.5\nShape \"disk\" \"float radius\" 0.5\n"
+                                   "AttributeEnd\n") +
+           "WorldEnd\n";
+}
+
+// A sky seen from inside a bounded medium: the fog of boundedFog (radius-1 null-material
+// sphere, camera at its centre) under an infinite light of radiance L, from an image map of
+// constant texels when `map` is set (the map's sampling distribution, pdf and lookups), else
+// from "rgb L" (the constant sky's own sampling). The light is rotated, as volume-boundary's.
+// Lossless fog conserves L; a purely absorbing one gives L exp(-sigma_a).
+std::string skyOverBoundedFog(double sigmaA, double sigmaS, double g, double L,
+                              const std::string& map) {
+    const std::string a = num(sigmaA), s = num(sigmaS), l = num(L);
+    const std::string light =
+        map.empty() ? "LightSource \"infinite\" \"rgb L\" [" + l + " " + l + " " + l + "]\n"
+                    : "LightSource \"infinite\" \"string mapname\" \"" + map +
+                          "\" \"rgb scale\" [" + l + " " + l + " " + l + "]\n";
+    return "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [" + a +
+           " " + a + " " + a + "] \"rgb sigma_s\" [" + s + " " + s + " " + s +
+           "] \"float g\" " + num(g) + "\n"
+           "MediumInterface \"\" \"fog\"\nLookAt 0 0 0  0.3 -0.2 -1  0 1 0\n"
+           "Camera \"perspective\" \"float fov\" 60\n"
+           "Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 24\n"
+           "PixelFilter \"box\" \"float xwidth\" 0.5 \"float ywidth\" 0.5\n"
+           "Sampler \"sobol\" \"integer pixelsamples\" 64\n"
+           "Integrator \"volpath\" \"integer maxdepth\" 1000\n"
+           "WorldBegin\n"
+           "AttributeBegin\nRotate 40 0 0 1\n" + light + "AttributeEnd\n"
+           "AttributeBegin\n"
+           "MediumInterface \"fog\" \"\"\n"
+           "Material \"\"\n"
+           "Shape \"sphere\" \"float radius\" 1\n"
+           "AttributeEnd\n"
+           "WorldEnd\n";
+}
+
 const char* kBackends[] = {"none", "hemi", "vdb"};
 
 class Analytic : public ::testing::TestWithParam<const char*> {};
@@ -375,6 +441,62 @@ TEST_P(Analytic, LightFromOutsideABoundedMedium) {
                        num(f.sigmaS) + " g " + num(f.g));
     expectMean(renderText(boundedFog(0.7, 0.0, 0.0, 1.0, true), GetParam()), std::exp(-0.7),
                "absorbing fog");
+}
+
+// pbrt-v3's depth limit at a null-material interface (issue 33): the interface ends a path
+// that reaches it at maxdepth where the light beyond would count at full weight (after a
+// specular bounce, or the camera ray at maxdepth 0), and only there. volume-boundary's glass
+// sphere at the fifth vertex, seen through the fog, made rlpbrt's mean 0.17% brighter than
+// pbrt-v3's when the interface let such paths through.
+TEST_P(Analytic, InterfaceAtTheDepthLimit) {
+    const std::string mirror = "\"mirror\" \"rgb Kr\" [1 1 1]";
+    const std::string matte = "\"matte\" \"rgb Kd\" [0.6 0.6 0.6]";
+    const double L = 2.0;
+    expectMean(renderText(interfaceAtDepthLimit(mirror, 1, true, L), GetParam()), 0.0,
+               "mirror, maxdepth 1: the reflection ends at the interface");
+    expectMean(renderText(interfaceAtDepthLimit(mirror, 2, true, L), GetParam()), L,
+               "mirror, maxdepth 2: the reflection crosses the interface");
+    expectMean(renderText(interfaceAtDepthLimit(mirror, 1, false, L), GetParam()), L,
+               "mirror, maxdepth 1, no interface");
+    expectMean(renderText(interfaceAtDepthLimit(matte, 1, true, L), GetParam()), 0.6 * L,
+               "matte, maxdepth 1: next-event estimation crosses the interface");
+    expectMean(renderText(interfaceAtDepthLimit("", 0, true, L, true), GetParam()), 0.0,
+               "camera ray at maxdepth 0 ends at the interface");
+    expectMean(renderText(interfaceAtDepthLimit("", 0, false, L, true), GetParam()), L,
+               "camera ray at maxdepth 0, no interface");
+}
+
+// The sky through a null-material boundary (issue 33's volume-boundary is lit this way):
+// camera rays that leave the fog, next-event estimation from medium vertices to the sky
+// across the boundary, and phase-sampled rays that cross it and find the sky (MIS-weighted
+// against the light's pdf). A map of constant texels (1.5) scaled by 2, and a constant sky.
+TEST_P(Analytic, SkyThroughABoundedMedium) {
+    char path[] = "/tmp/rlpbrt-analytic-sky-XXXXXX.exr";
+    const int fd = mkstemps(path, 4);
+    ASSERT_GE(fd, 0);
+    ::close(fd);
+    Image map;
+    map.width = 16;
+    map.height = 8;
+    map.channels = 3;
+    map.pixels.assign(size_t(map.width) * size_t(map.height) * 3, 1.5f);
+    std::string err;
+    ASSERT_TRUE(writeImage(path, map, {}, &err)) << err;
+    struct Fog {
+        double sigmaA, sigmaS, g;
+    };
+    for (const std::string& m : {std::string(path), std::string()}) {
+        const double L = m.empty() ? 3.0 : 1.5 * 2.0;
+        const std::string what = m.empty() ? "constant sky" : "sky map";
+        for (Fog f : {Fog{0.0, 0.5, 0.0}, Fog{0.0, 3.0, 0.3}, Fog{0.7, 0.0, 0.0}})
+            expectMean(renderText(skyOverBoundedFog(f.sigmaA, f.sigmaS, f.g,
+                                                    m.empty() ? L : 2.0, m),
+                                  GetParam()),
+                       L * std::exp(-f.sigmaA),
+                       what + ", sigma_a " + num(f.sigmaA) + " sigma_s " + num(f.sigmaS) +
+                           " g " + num(f.g));
+    }
+    std::remove(path);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Analytic, ::testing::ValuesIn(kBackends));
