@@ -86,6 +86,13 @@ public:
                              std::clamp(y - bounds_.pMin.y, 0, h_ - 1))];
     }
 
+    // The estimates as they stand (empty until the first refresh), and their restoring
+    // (a resumed render's; ignored if the size does not match).
+    const std::vector<float>& values() const { return values_; }
+    void setValues(const std::vector<float>& v) {
+        if (v.empty() || v.size() == size_t(w_) * size_t(h_)) values_ = v;
+    }
+
 private:
     size_t index(int x, int y) const { return size_t(y) * size_t(w_) + size_t(x); }
     Bounds2i bounds_;
@@ -171,6 +178,50 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     long long pixelsPerPass = 0;
     for (const auto& t : tiles) pixelsPerPass += (long long)t.area();
     int pass = 0;
+    // Resuming (render/resume.h): the state after the snapshot's last pass. The statistics
+    // of the passes before are added after the ranks' sums (they are all ranks' already).
+    PathStats earlierStats;
+    if (const RenderSnapshot* snap = options.resume) {
+        film.setSums(snap->film);
+        estimates.setValues(snap->estimates);
+        result.spp = snap->spp;
+        pass = snap->passes;
+        start -= snap->seconds;
+        samplesDone = pixelsPerPass * snap->spp;
+        earlierStats = snap->stats;
+        trial = Trial::Done;  // a snapshot is resumable only after the trial
+        history.reset();
+        if (field) {
+            guided = snap->guided;
+            result.autoTrial.ran = snap->autoRan;
+            result.autoTrial.keptGuiding = snap->autoKept;
+            result.autoTrial.guidedSpp = snap->autoGuidedSpp;
+            result.autoTrial.guidedCost = snap->autoGuidedCost;
+            result.autoTrial.plainCost = snap->autoPlainCost;
+            if (!guided) plainIntegrator = std::make_unique<PathIntegrator>(scene, GuideSettings());
+            if (snap->frozen) {
+                GuideSettings frozen = options.guide;
+                frozen.learn = false;
+                frozenIntegrator = std::make_unique<PathIntegrator>(scene, frozen);
+                result.learningSpp = snap->learningSpp;
+            }
+        }
+    }
+    // The path statistics so far, of all ranks (a collective with ranks).
+    auto statsSoFar = [&] {
+        PathStats s;
+        for (const auto& t : stats) s.add(t);
+        if (ranks) {
+            double sums[5] = {double(s.paths), double(s.rays), double(s.vertices),
+                              double(s.zeroRadiancePaths), double(s.nonFinite)};
+            ranks->sumDoubles(sums, 5);
+            s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]);
+            s.vertices = uint64_t(sums[2]);
+            s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
+        }
+        s.add(earlierStats);
+        return s;
+    };
     for (;;) {
         int count = guided ? std::clamp(result.spp / 2, 1, kMaxGuidedPass) : 1;
         if (trial == Trial::MeasurePlain) count = guidedCount;
@@ -332,6 +383,41 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                           samplesDone / std::max(elapsed, 1e-9));
         bool stop = options.cancel && options.cancel->load();
         if (ranks) ranks->broadcast(&stop, sizeof(stop));  // rank 0 decides
+        // A snapshot for resuming (render/resume.h), where rank 0's hook wants one.
+        bool snapshot = false;
+        if (!ranks || ranks->rank() == 0)
+            snapshot = options.snapshotDue && options.snapshotDue(result.spp, elapsed, stop);
+        if (ranks) ranks->broadcast(&snapshot, sizeof(snapshot));
+        if (snapshot) {
+            RenderSnapshot snap;
+            snap.stats = statsSoFar();  // (all ranks take part)
+            if ((!ranks || ranks->rank() == 0) && options.onSnapshot) {
+                snap.passes = pass;
+                snap.spp = result.spp;
+                snap.seconds = elapsed;
+                snap.ranks = ranks ? ranks->size() : 1;
+                snap.guided = guided;
+                snap.autoRan = result.autoTrial.ran;
+                snap.autoKept = result.autoTrial.keptGuiding;
+                snap.autoGuidedSpp = result.autoTrial.guidedSpp;
+                snap.autoGuidedCost = result.autoTrial.guidedCost;
+                snap.autoPlainCost = result.autoTrial.plainCost;
+                snap.frozen = frozenIntegrator != nullptr;
+                snap.learningSpp = result.learningSpp;
+                bool resumable = trial == Trial::Done;
+                if (!resumable) snap.guide = "the auto trial is under way";
+                if (resumable) {
+                    snap.film = film.sums();
+                    snap.estimates = estimates.values();
+                    std::string err;
+                    if (field && !field->saveState(&snap.guide, &err)) {
+                        resumable = false;
+                        snap.guide = err;  // (the reason, for the hook's message)
+                    }
+                }
+                options.onSnapshot(snap, resumable, film);
+            }
+        }
         if (stop) {
             result.cancelled = true;
             break;
@@ -341,15 +427,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     if (!frozenIntegrator) result.learningSpp = result.autoTrial.guidedSpp;
     if (options.progress) std::fprintf(stderr, "\n");
     result.seconds = now() - start;
-    for (const auto& s : stats) result.stats.add(s);
+    result.stats = statsSoFar();
     result.passes = pass;
     if (ranks) {
-        PathStats& s = result.stats;
-        double sums[5] = {double(s.paths), double(s.rays), double(s.vertices),
-                          double(s.zeroRadiancePaths), double(s.nonFinite)};
-        ranks->sumDoubles(sums, 5);
-        s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]), s.vertices = uint64_t(sums[2]);
-        s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
         result.ranks = ranks->size();
         result.bytesExchanged = ranks->bytesExchanged();
         result.secondsExchanging = ranks->secondsExchanging() - exchangeBefore;

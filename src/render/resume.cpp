@@ -1,0 +1,149 @@
+#include "render/resume.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "guiding/field_io.h"
+
+namespace rlpbrt {
+
+namespace {
+
+constexpr char kMagic[8] = {'R', 'L', 'P', 'B', 'R', 'S', 'U', 'M'};
+constexpr uint32_t kVersion = 1;
+// Bounds on what a reader accepts (a corrupt count must not allocate without limit).
+constexpr uint64_t kMaxEntries = 4096;
+constexpr uint64_t kMaxFilmDoubles = uint64_t(1) << 30;
+
+}  // namespace
+
+uint64_t fnv1a(const std::string& bytes, uint64_t hash) {
+    for (unsigned char c : bytes) {
+        hash ^= c;
+        hash *= 0x100000001b3ull;
+    }
+    return hash;
+}
+
+bool writeResumeFile(const std::string& path, const ResumeFingerprint& fingerprint,
+                     const RenderSnapshot& s, std::string* error) {
+    guiding::fieldio::Writer w;
+    w.data.reserve(64 + s.film.size() * 8 + s.estimates.size() * 4 + s.guide.size());
+    w.raw(kMagic, 8);
+    w.u32(kVersion);
+    w.u64(fingerprint.size());
+    for (const auto& [key, value] : fingerprint) {
+        w.blob(key);
+        w.blob(value);
+    }
+    w.u32(uint32_t(s.passes));
+    w.u32(uint32_t(s.spp));
+    w.f64(s.seconds);
+    w.u64(s.stats.paths), w.u64(s.stats.rays), w.u64(s.stats.vertices);
+    w.u64(s.stats.zeroRadiancePaths), w.u64(s.stats.nonFinite);
+    w.u32(uint32_t(s.ranks));
+    w.u32((s.guided ? 1u : 0u) | (s.autoRan ? 2u : 0u) | (s.autoKept ? 4u : 0u) |
+          (s.frozen ? 8u : 0u));
+    w.u32(uint32_t(s.autoGuidedSpp));
+    w.f64(s.autoGuidedCost);
+    w.f64(s.autoPlainCost);
+    w.u32(uint32_t(s.learningSpp));
+    w.u64(s.film.size());
+    for (double d : s.film) w.f64(d);
+    w.u64(s.estimates.size());
+    for (float f : s.estimates) w.f32(f);
+    w.blob(s.guide);
+    w.u64(fnv1a(w.data));
+    return guiding::fieldio::writeFile(path, w.data, error);
+}
+
+bool readResumeFile(const std::string& path, ResumeFingerprint* fingerprint,
+                    RenderSnapshot* out, std::string* error) {
+    std::string data;
+    std::string err;
+    if (!guiding::fieldio::readFile(path, &data, &err)) {
+        *error = "cannot read the resume file (" + err + ")";
+        return false;
+    }
+    auto fail = [&](const std::string& why) {
+        *error = why;
+        return false;
+    };
+    if (data.size() < 12 || std::memcmp(data.data(), kMagic, 8) != 0)
+        return fail("not an rlpbrt resume file");
+    guiding::fieldio::Reader r(data);
+    r.skip(8);
+    const uint32_t version = r.u32();
+    if (version != kVersion)
+        return fail("resume file version " + std::to_string(version) + ", this rlpbrt reads " +
+                    std::to_string(kVersion));
+    if (data.size() < 20) return fail("truncated resume file");
+    {
+        const std::string body = data.substr(0, data.size() - 8);
+        guiding::fieldio::Reader tail(data);
+        tail.skip(data.size() - 8);
+        if (tail.u64() != fnv1a(body))
+            return fail("truncated or corrupt resume file (checksum mismatch)");
+    }
+    ResumeFingerprint fp;
+    const uint64_t entries = r.u64();
+    if (!r.ok() || entries > kMaxEntries) return fail("corrupt resume file (fingerprint)");
+    for (uint64_t i = 0; i < entries; ++i) {
+        std::string key = r.blob(), value = r.blob();
+        fp.emplace_back(std::move(key), std::move(value));
+    }
+    RenderSnapshot s;
+    s.passes = int(r.u32());
+    s.spp = int(r.u32());
+    s.seconds = r.f64();
+    s.stats.paths = r.u64(), s.stats.rays = r.u64(), s.stats.vertices = r.u64();
+    s.stats.zeroRadiancePaths = r.u64(), s.stats.nonFinite = r.u64();
+    s.ranks = int(r.u32());
+    const uint32_t flags = r.u32();
+    s.guided = flags & 1u, s.autoRan = flags & 2u, s.autoKept = flags & 4u, s.frozen = flags & 8u;
+    s.autoGuidedSpp = int(r.u32());
+    s.autoGuidedCost = r.f64();
+    s.autoPlainCost = r.f64();
+    s.learningSpp = int(r.u32());
+    const uint64_t filmCount = r.u64();
+    if (!r.ok() || filmCount > kMaxFilmDoubles || filmCount * 8 > r.remaining() ||
+        filmCount % 4 != 0)
+        return fail("corrupt resume file (film)");
+    s.film.resize(size_t(filmCount));
+    for (double& d : s.film) d = r.f64();
+    const uint64_t estCount = r.u64();
+    if (!r.ok() || estCount * 4 > r.remaining()) return fail("corrupt resume file (estimates)");
+    s.estimates.resize(size_t(estCount));
+    for (float& f : s.estimates) f = r.f32();
+    s.guide = r.blob();
+    if (!r.ok() || r.remaining() != 8) return fail("corrupt resume file (sizes)");
+    if (s.passes < 0 || s.spp < 0 || s.ranks < 1 || !(s.seconds >= 0.0) ||
+        !std::isfinite(s.seconds))
+        return fail("corrupt resume file (counters)");
+    *fingerprint = std::move(fp);
+    *out = std::move(s);
+    return true;
+}
+
+std::string fingerprintMismatch(const ResumeFingerprint& saved, const ResumeFingerprint& now) {
+    std::string out;
+    auto add = [&](const std::string& what) { out += (out.empty() ? "" : "; ") + what; };
+    for (const auto& [key, value] : now) {
+        const std::string* old = nullptr;
+        for (const auto& kv : saved)
+            if (kv.first == key) old = &kv.second;
+        if (!old)
+            add(key + " is not in the file");
+        else if (*old != value)
+            add(key + " is " + (value.empty() ? "(none)" : value) + " here, " +
+                (old->empty() ? "(none)" : *old) + " in the file");
+    }
+    for (const auto& kv : saved) {
+        bool found = false;
+        for (const auto& n : now) found = found || n.first == kv.first;
+        if (!found) add(kv.first + " is in the file, not here");
+    }
+    return out;
+}
+
+}  // namespace rlpbrt
