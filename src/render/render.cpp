@@ -189,8 +189,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         start -= snap->seconds;
         samplesDone = pixelsPerPass * snap->spp;
         earlierStats = snap->stats;
-        trial = Trial::Done;  // a snapshot is resumable only after the trial
-        history.reset();
+        // The auto trial where it stood (a state without one, or after it: over).
+        trial = snap->trial == 1 ? Trial::Pending : snap->trial == 2 ? Trial::MeasurePlain
+                                                                      : Trial::Done;
+        if (trial == Trial::Done || !history || !history->setState(snap->trialHistory))
+            trial = Trial::Done, history.reset();
+        if (trial == Trial::MeasurePlain) {
+            guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
+            guidedSecondsPerSample = snap->trialGuidedSecondsPerSample;
+            guidedCount = snap->trialGuidedCount;
+            if (!guidedMoments->setState(snap->trialGuided))
+                trial = Trial::Done, history.reset(), guidedMoments.reset();
+        }
         if (field) {
             guided = snap->guided;
             result.autoTrial.ran = snap->autoRan;
@@ -404,9 +414,13 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 snap.autoPlainCost = result.autoTrial.plainCost;
                 snap.frozen = frozenIntegrator != nullptr;
                 snap.learningSpp = result.learningSpp;
-                bool resumable = trial == Trial::Done;
-                if (!resumable) snap.guide = "the auto trial is under way";
-                if (resumable) {
+                snap.trial = trial == Trial::Pending ? 1 : trial == Trial::MeasurePlain ? 2 : 0;
+                if (history) snap.trialHistory = history->state();
+                if (guidedMoments) snap.trialGuided = guidedMoments->state();
+                snap.trialGuidedSecondsPerSample = guidedSecondsPerSample;
+                snap.trialGuidedCount = guidedCount;
+                bool resumable = true;
+                {
                     snap.film = film.sums();
                     snap.estimates = estimates.values();
                     std::string err;

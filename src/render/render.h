@@ -37,9 +37,8 @@ struct RenderOptions {
     // Snapshots: after each pass and its onPass, rank 0 asks snapshotDue(spp, seconds, stop)
     // (stop: the render stops after this pass, cancelled); where it says yes, the statistics
     // are summed over the ranks and onSnapshot gets the snapshot and the film on rank 0.
-    // resumable false: the snapshot cannot be resumed from (during the auto trial, whose
-    // measurements it does not keep, or where the guide cannot save its state), and its
-    // `guide` holds the reason.
+    // resumable false: the snapshot cannot be resumed from (the guide cannot save its state),
+    // and its `guide` holds the reason.
     std::function<bool(int spp, double seconds, bool stop)> snapshotDue;
     std::function<void(const RenderSnapshot& snapshot, bool resumable, const Film& film)>
         onSnapshot;

@@ -48,6 +48,11 @@ bool writeResumeFile(const std::string& path, const ResumeFingerprint& fingerpri
     w.f64(s.autoGuidedCost);
     w.f64(s.autoPlainCost);
     w.u32(uint32_t(s.learningSpp));
+    w.u32(uint32_t(s.trial));
+    w.blob(s.trialHistory);
+    w.blob(s.trialGuided);
+    w.f64(s.trialGuidedSecondsPerSample);
+    w.u32(uint32_t(s.trialGuidedCount));
     w.u64(s.film.size());
     for (double d : s.film) w.f64(d);
     w.u64(s.estimates.size());
@@ -105,6 +110,12 @@ bool readResumeFile(const std::string& path, ResumeFingerprint* fingerprint,
     s.autoGuidedCost = r.f64();
     s.autoPlainCost = r.f64();
     s.learningSpp = int(r.u32());
+    s.trial = int(r.u32());
+    s.trialHistory = r.blob();
+    s.trialGuided = r.blob();
+    s.trialGuidedSecondsPerSample = r.f64();
+    s.trialGuidedCount = int(r.u32());
+    if (!r.ok() || s.trial < 0 || s.trial > 2) return fail("corrupt resume file (auto trial)");
     const uint64_t filmCount = r.u64();
     if (!r.ok() || filmCount > kMaxFilmDoubles || filmCount * 8 > r.remaining() ||
         filmCount % 4 != 0)

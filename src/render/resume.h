@@ -30,6 +30,13 @@ struct RenderSnapshot {
     double autoGuidedCost = 0.0, autoPlainCost = 0.0;
     bool frozen = false;
     int learningSpp = 0;
+    // The auto trial under way (0: none or over; 1: waiting for its guided pass; 2: its guided
+    // pass measured, the plain one next): PassMoments::state of the pixel means so far and of
+    // the guided pass, and the guided pass's CPU seconds per sample and spp.
+    int trial = 0;
+    std::string trialHistory, trialGuided;
+    double trialGuidedSecondsPerSample = 0.0;
+    int trialGuidedCount = 0;
     std::vector<double> film;       // Film::sums()
     std::vector<float> estimates;   // the adjoint roulette's pixel estimates (empty: none yet)
     std::string guide;              // GuidingField::saveState (empty without a guide)

@@ -139,6 +139,7 @@ TEST_P(Resume, EqualsUninterrupted) {
     if (params.rfind("mix=learn", 0) == 0) EXPECT_GT(first.guideStats.selectionRegions, 0u);
     if (params == "rr=adjoint") EXPECT_FALSE(first.snapshot.estimates.empty());
     if (params == "learn=4") EXPECT_TRUE(first.snapshot.frozen);
+    if (params == "auto=4") EXPECT_EQ(first.snapshot.trial, c.stopAt == 2 ? 1 : 2);
     if (c.fog && std::string(c.guide) == "vdb") EXPECT_GT(first.guideStats.mediumCells, 0u);
     // Through the file, and on another thread count.
     const std::string path = tempDir() + "/state.resume";
@@ -154,6 +155,14 @@ TEST_P(Resume, EqualsUninterrupted) {
     EXPECT_EQ(second.result.spp, whole.result.spp);
     EXPECT_EQ(second.result.passes, whole.result.passes);
     ASSERT_EQ(second.result.image.pixels.size(), whole.result.image.pixels.size());
+    // The auto trial's verdict rests on CPU time, which no two runs share: the resumed render
+    // must finish the trial, and give the same image where it reaches the same verdict.
+    if (std::string(c.params).rfind("auto=", 0) == 0) {
+        EXPECT_TRUE(second.result.autoTrial.ran);
+        if (second.result.autoTrial.keptGuiding != whole.result.autoTrial.keptGuiding)
+            GTEST_SKIP() << "the auto trial's verdicts differ (timing)";
+        EXPECT_EQ(second.result.autoTrial.guidedSpp, whole.result.autoTrial.guidedSpp);
+    }
     EXPECT_TRUE(second.result.image.pixels == whole.result.image.pixels)
         << "the resumed image differs from the uninterrupted one";
     EXPECT_EQ(second.result.stats.paths, whole.result.stats.paths);
@@ -176,7 +185,10 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"hemi", "mix=learn points=32", false, 8, "hemi_mix_learn"},
                       Case{"hemi", "learn=4", false, 6, "hemi_learn_4"},
                       Case{"hemi", "rr=adjoint", false, 10, "hemi_adjoint_roulette"},
-                      Case{"vdb", "samples=independent", false, 3, "vdb_independent"}),
+                      Case{"vdb", "samples=independent", false, 3, "vdb_independent"},
+                      // Stopped before the auto trial's guided pass, and between its two.
+                      Case{"hemi", "auto=4", false, 2, "hemi_auto_pending"},
+                      Case{"hemi", "auto=4", false, 6, "hemi_auto_between"}),
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
 
 // With a time budget, the time the snapshot had spent counts: a state that spent more than
