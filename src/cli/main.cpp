@@ -168,8 +168,9 @@ int main(int argc, char** argv) {
         ->group(gOutput);
     app.add_flag("--quiet,-q", quiet, "no progress or summary output")->group(gOutput);
     app.add_option("--checkpoint", checkpointEvery,
-                   "write the image so far (atomically, real spp in its metadata) after each "
-                   "pass once SECONDS have passed since the last checkpoint")
+                   "write the image so far (atomically, real spp in its metadata) and the "
+                   "restart state OUTFILE.resume (for --resume) after each pass once SECONDS "
+                   "have passed since the last checkpoint, and when stopped by a signal")
         ->check(CLI::Range(0.0, 1e9))
         ->group(gOutput);
     app.add_option("--resume", resumeFile,
