@@ -328,7 +328,11 @@ int main(int argc, char** argv) {
     Checkpointer checkpoint(outFile, checkpointEvery, metadata);
     // Resuming (docs/DISTRIBUTED.md, "Resume"): every rank reads the state itself (a shared
     // file system, as for the scene); one that does not match the scene and options stops all.
-    const ResumeFingerprint fingerprint = resumeFingerprint(scenePath, *scene, seed, timeBudget, gc);
+    // (The scene file is read again for its hash only where a state is written or read.)
+    const ResumeFingerprint fingerprint =
+        checkpointEvery >= 0.0 || !resumeFile.empty()
+            ? resumeFingerprint(scenePath, *scene, seed, timeBudget, gc)
+            : ResumeFingerprint();
     RenderSnapshot resumed;
     if (!resumeFile.empty()) {
         ResumeFingerprint saved;
