@@ -391,14 +391,17 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (options.progress)
             printProgress(pass, result.spp, totalSpp, elapsed, options.timeBudget,
                           samplesDone / std::max(elapsed, 1e-9));
-        bool stop = options.cancel && options.cancel->load();
-        if (ranks) ranks->broadcast(&stop, sizeof(stop));  // rank 0 decides
-        // A snapshot for resuming (render/resume.h), where rank 0's hook wants one.
-        bool snapshot = false;
-        if (!ranks || ranks->rank() == 0)
-            snapshot = options.snapshotDue && options.snapshotDue(result.spp, elapsed, stop);
-        if (ranks) ranks->broadcast(&snapshot, sizeof(snapshot));
-        if (snapshot) {
+        // Rank 0 decides whether to stop, and whether to take a snapshot for resuming
+        // (render/resume.h) where its hook wants one.
+        bool decisions[2] = {false, false};  // stop, snapshot
+        if (!ranks || ranks->rank() == 0) {
+            decisions[0] = options.cancel && options.cancel->load();
+            decisions[1] = options.snapshotDue &&
+                           options.snapshotDue(result.spp, elapsed, decisions[0]);
+        }
+        if (ranks) ranks->broadcast(decisions, sizeof(decisions));
+        const bool stop = decisions[0];
+        if (decisions[1]) {
             RenderSnapshot snap;
             snap.stats = statsSoFar();  // (all ranks take part)
             if ((!ranks || ranks->rank() == 0) && options.onSnapshot) {
@@ -419,16 +422,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 if (guidedMoments) snap.trialGuided = guidedMoments->state();
                 snap.trialGuidedSecondsPerSample = guidedSecondsPerSample;
                 snap.trialGuidedCount = guidedCount;
-                bool resumable = true;
-                {
-                    snap.film = film.sums();
-                    snap.estimates = estimates.values();
-                    std::string err;
-                    if (field && !field->saveState(&snap.guide, &err)) {
-                        resumable = false;
-                        snap.guide = err;  // (the reason, for the hook's message)
-                    }
-                }
+                snap.film = film.sums();
+                snap.estimates = estimates.values();
+                std::string err;
+                const bool resumable = !field || field->saveState(&snap.guide, &err);
+                if (!resumable) snap.guide = err;  // (the reason, for the hook's message)
                 options.onSnapshot(snap, resumable, film);
             }
         }
