@@ -15,6 +15,43 @@ constexpr uint32_t kVersion = 1;
 constexpr uint64_t kMaxEntries = 4096;
 constexpr uint64_t kMaxFilmDoubles = uint64_t(1) << 30;
 
+// Arrays of doubles or floats, little-endian: copied as they are on a little-endian machine
+// (the film's sums are most of a state's bytes), value by value elsewhere.
+constexpr bool kLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+
+template <class T>
+void writeArray(guiding::fieldio::Writer& w, const std::vector<T>& v) {
+    static_assert(sizeof(T) == 4 || sizeof(T) == 8, "floats or doubles");
+    w.u64(v.size());
+    if (kLittleEndian) {
+        w.raw(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+        return;
+    }
+    for (T x : v) {
+        if constexpr (sizeof(T) == 8) w.f64(x);
+        else w.f32(x);
+    }
+}
+
+// false if the count runs past the end or above maxCount.
+template <class T>
+bool readArray(guiding::fieldio::Reader& r, const std::string& data, std::vector<T>* v,
+               uint64_t maxCount) {
+    const uint64_t n = r.u64();
+    if (!r.ok() || n > maxCount || n * sizeof(T) > r.remaining()) return false;
+    v->resize(size_t(n));
+    if (kLittleEndian) {
+        const size_t at = data.size() - r.remaining();
+        std::memcpy(v->data(), data.data() + at, size_t(n) * sizeof(T));
+        return r.skip(size_t(n) * sizeof(T));
+    }
+    for (T& x : *v) {
+        if constexpr (sizeof(T) == 8) x = r.f64();
+        else x = r.f32();
+    }
+    return r.ok();
+}
+
 }  // namespace
 
 uint64_t fnv1a(const std::string& bytes, uint64_t hash) {
@@ -53,10 +90,8 @@ bool writeResumeFile(const std::string& path, const ResumeFingerprint& fingerpri
     w.blob(s.trialGuided);
     w.f64(s.trialGuidedSecondsPerSample);
     w.u32(uint32_t(s.trialGuidedCount));
-    w.u64(s.film.size());
-    for (double d : s.film) w.f64(d);
-    w.u64(s.estimates.size());
-    for (float f : s.estimates) w.f32(f);
+    writeArray(w, s.film);
+    writeArray(w, s.estimates);
     w.blob(s.guide);
     w.u64(fnv1a(w.data));
     return guiding::fieldio::writeFile(path, w.data, error);
@@ -116,16 +151,10 @@ bool readResumeFile(const std::string& path, ResumeFingerprint* fingerprint,
     s.trialGuidedSecondsPerSample = r.f64();
     s.trialGuidedCount = int(r.u32());
     if (!r.ok() || s.trial < 0 || s.trial > 2) return fail("corrupt resume file (auto trial)");
-    const uint64_t filmCount = r.u64();
-    if (!r.ok() || filmCount > kMaxFilmDoubles || filmCount * 8 > r.remaining() ||
-        filmCount % 4 != 0)
+    if (!readArray(r, data, &s.film, kMaxFilmDoubles) || s.film.size() % 4 != 0)
         return fail("corrupt resume file (film)");
-    s.film.resize(size_t(filmCount));
-    for (double& d : s.film) d = r.f64();
-    const uint64_t estCount = r.u64();
-    if (!r.ok() || estCount * 4 > r.remaining()) return fail("corrupt resume file (estimates)");
-    s.estimates.resize(size_t(estCount));
-    for (float& f : s.estimates) f = r.f32();
+    if (!readArray(r, data, &s.estimates, kMaxFilmDoubles / 4))
+        return fail("corrupt resume file (estimates)");
     s.guide = r.blob();
     if (!r.ok() || r.remaining() != 8) return fail("corrupt resume file (sizes)");
     if (s.passes < 0 || s.spp < 0 || s.ranks < 1 || !(s.seconds >= 0.0) ||
