@@ -255,6 +255,11 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "error: --guide-load/--guide-save need a guiding backend\n");
             return fail();
         }
+        if (!guideLoad.empty() && !resumeFile.empty()) {
+            std::fprintf(stderr, "warning: --guide-load is ignored with --resume (the restart "
+                                 "state holds the guide)\n");
+            guideLoad.clear();
+        }
         if (!guideLoad.empty() && !field->load(guideLoad, &gerr)) {
             std::fprintf(stderr, "error: --guide-load: %s\n", gerr.c_str());
             return fail();
@@ -263,7 +268,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "guide: %s (%.2f s to build)\n", field->describe().c_str(),
                          seconds() - tg);
     }
-    if (field && guideSettings.learnSpp == 0 && guideLoad.empty())
+    if (field && guideSettings.learnSpp == 0 && guideLoad.empty() && resumeFile.empty())
         std::fprintf(stderr, "warning: learn=0 without --guide-load: the guide never learns, "
                              "so every vertex samples its BSDF (at the guide's cost)\n");
     const float mix = guideSettings.mix;
@@ -369,8 +374,9 @@ int main(int argc, char** argv) {
                                  "uninterrupted one\n",
                          resumeFile.c_str(), resumed.ranks, nRanks);
         if (!quiet)
-            std::fprintf(stderr, "resuming after pass %d (%d spp, %.2f s)\n", resumed.passes,
-                         resumed.spp, resumed.seconds);
+            std::fprintf(stderr, "resuming after pass %d (%d spp, %.2f s)%s%s\n",
+                         resumed.passes, resumed.spp, resumed.seconds,
+                         field ? "; guide: " : "", field ? field->describe().c_str() : "");
         checkpoint.setLast(resumed.seconds);
         ro.resume = &resumed;
     }
