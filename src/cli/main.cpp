@@ -20,6 +20,7 @@
 #include "render/image_io.h"
 #include "render/metrics.h"
 #include "render/render.h"
+#include "render/resume.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
 
@@ -59,6 +60,41 @@ void printSummary(const SceneDesc& desc, const Scene& scene, const Diagnostics& 
     for (const auto& [what, count] : ignored) std::printf("  %s (x%d)\n", what.c_str(), count);
 }
 
+// What a resumed render must share with the one that wrote the state (render/resume.h): the
+// scene file's contents, the film, the sampler, the spp or time budget, the seed, the guide
+// and its parameters. Not the threads (images do not depend on them), nor the output.
+ResumeFingerprint resumeFingerprint(const std::string& scenePath, const Scene& scene,
+                                    uint64_t seed, double timeBudget,
+                                    const guiding::GuideConfig& guide) {
+    std::string sceneHash = "unreadable";
+    {
+        std::ifstream f(scenePath, std::ios::binary);
+        std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+        char buf[32];
+        std::snprintf(buf, sizeof(buf), "%016llx", (unsigned long long)fnv1a(text));
+        if (f || f.eof()) sceneHash = buf;
+    }
+    const FilmParams& fp = scene.filmParams;
+    const Bounds2i pb = fp.pixelBounds();
+    char film[160];
+    std::snprintf(film, sizeof(film), "%dx%d, pixels [%d,%d)x[%d,%d)", fp.xResolution,
+                  fp.yResolution, pb.pMin.x, pb.pMax.x, pb.pMin.y, pb.pMax.y);
+    std::string params;
+    for (const auto& [k, v] : guide.params) params += (params.empty() ? "" : " ") + k + "=" + v;
+    char budget[64];
+    std::snprintf(budget, sizeof(budget), "%.17g", timeBudget);
+    return {
+        {"the scene file's contents (FNV-1a)", sceneHash},
+        {"the film", film},
+        {"the sampler", scene.samplerName},
+        {"spp", std::to_string(scene.sampler->samplesPerPixel())},
+        {"--time", timeBudget > 0.0 ? budget : ""},
+        {"--seed", std::to_string(seed)},
+        {"--guide", guide.backend},
+        {"--guide-param", params},
+    };
+}
+
 std::string defaultOutput(const Scene& scene) {
     return scene.filmParams.filename.empty() ? std::string("pbrt.exr") : scene.filmParams.filename;
 }
@@ -84,7 +120,8 @@ int main(int argc, char** argv) {
     };
     CLI::App app{"rlpbrt: a pbrt-v3 scene renderer with reinforcement-learned path guiding"};
     std::string scenePath, outFile, statsFile, guide = "hemi", curveFile, refFile;
-    std::string guideSave, guideLoad;
+    std::string guideSave, guideLoad, resumeFile;
+    int cancelAtSpp = 0;
     bool parseOnly = false, quiet = false, strict = false;
     int spp = 0, nThreads = 0;
     double timeBudget = 0.0, checkpointEvery = -1.0;
@@ -131,10 +168,17 @@ int main(int argc, char** argv) {
         ->group(gOutput);
     app.add_flag("--quiet,-q", quiet, "no progress or summary output")->group(gOutput);
     app.add_option("--checkpoint", checkpointEvery,
-                   "write the image so far (atomically, real spp in its metadata) after each "
-                   "pass once SECONDS have passed since the last checkpoint")
+                   "write the image so far (atomically, real spp in its metadata) and the "
+                   "restart state OUTFILE.resume (for --resume) after each pass once SECONDS "
+                   "have passed since the last checkpoint, and when stopped by a signal")
         ->check(CLI::Range(0.0, 1e9))
         ->group(gOutput);
+    app.add_option("--resume", resumeFile,
+                   "continue the render whose restart state FILE holds (--checkpoint writes it "
+                   "to OUTFILE.resume; same scene and options)")
+        ->group(gOutput);
+    // (Tests: stop as a signal would, after the pass that reaches N spp. Hidden.)
+    app.add_option("--cancel-at-spp", cancelAtSpp, "")->group("");
     app.add_flag("--parse-only", parseOnly, "parse and build the scene, print a summary, exit")
         ->group(gDiagnostics);
     app.add_option("--stats", statsFile, "write run statistics as JSON")->group(gDiagnostics);
@@ -211,6 +255,11 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "error: --guide-load/--guide-save need a guiding backend\n");
             return fail();
         }
+        if (!guideLoad.empty() && !resumeFile.empty()) {
+            std::fprintf(stderr, "warning: --guide-load is ignored with --resume (the restart "
+                                 "state holds the guide)\n");
+            guideLoad.clear();
+        }
         if (!guideLoad.empty() && !field->load(guideLoad, &gerr)) {
             std::fprintf(stderr, "error: --guide-load: %s\n", gerr.c_str());
             return fail();
@@ -219,7 +268,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "guide: %s (%.2f s to build)\n", field->describe().c_str(),
                          seconds() - tg);
     }
-    if (field && guideSettings.learnSpp == 0 && guideLoad.empty())
+    if (field && guideSettings.learnSpp == 0 && guideLoad.empty() && resumeFile.empty())
         std::fprintf(stderr, "warning: learn=0 without --guide-load: the guide never learns, "
                              "so every vertex samples its BSDF (at the guide's cost)\n");
     const float mix = guideSettings.mix;
@@ -282,9 +331,78 @@ int main(int argc, char** argv) {
         };
     };
     Checkpointer checkpoint(outFile, checkpointEvery, metadata);
-    if (checkpointEvery >= 0.0 && root)
-        ro.onPass = chainOnPass(std::move(ro.onPass), [&](int spp, double t, const Film& film) {
-            checkpoint.onPass(spp, t, film);
+    // Resuming (docs/DISTRIBUTED.md, "Resume"): every rank reads the state itself (a shared
+    // file system, as for the scene); one that does not match the scene and options stops all.
+    // (The scene file is read again for its hash only where a state is written or read.)
+    const ResumeFingerprint fingerprint =
+        checkpointEvery >= 0.0 || !resumeFile.empty()
+            ? resumeFingerprint(scenePath, *scene, seed, timeBudget, gc)
+            : ResumeFingerprint();
+    RenderSnapshot resumed;
+    if (!resumeFile.empty()) {
+        ResumeFingerprint saved;
+        std::string rerr;
+        if (!readResumeFile(resumeFile, &saved, &resumed, &rerr)) {
+            std::fprintf(stderr, "%s: error: %s\n", resumeFile.c_str(), rerr.c_str());
+            return fail();
+        }
+        const std::string diff = fingerprintMismatch(saved, fingerprint);
+        if (!diff.empty()) {
+            std::fprintf(stderr, "%s: error: the state of another render: %s\n",
+                         resumeFile.c_str(), diff.c_str());
+            return fail();
+        }
+        if (resumed.film.size() != size_t(scene->filmParams.pixelBounds().area()) * 4) {
+            std::fprintf(stderr, "%s: error: corrupt resume file (film size)\n",
+                         resumeFile.c_str());
+            return fail();
+        }
+        if (field && !field->loadState(resumed.guide, &rerr)) {
+            std::fprintf(stderr, "%s: error: the guide's state: %s\n", resumeFile.c_str(),
+                         rerr.c_str());
+            return fail();
+        }
+        if (!field && !resumed.guide.empty()) {
+            std::fprintf(stderr, "%s: error: corrupt resume file (a guide state without a "
+                                 "guide)\n", resumeFile.c_str());
+            return fail();
+        }
+        const int nRanks = ranks ? ranks->size() : 1;
+        if (resumed.ranks != nRanks)
+            std::fprintf(stderr, "warning: %s was written by %d rank(s), this run has %d: the "
+                                 "result is a valid render, but not bit for bit the "
+                                 "uninterrupted one\n",
+                         resumeFile.c_str(), resumed.ranks, nRanks);
+        if (!quiet)
+            std::fprintf(stderr, "resuming after pass %d (%d spp, %.2f s)%s%s\n",
+                         resumed.passes, resumed.spp, resumed.seconds,
+                         field ? "; guide: " : "", field ? field->describe().c_str() : "");
+        checkpoint.setLast(resumed.seconds);
+        ro.resume = &resumed;
+    }
+    // With --checkpoint, rank 0 writes the image and the restart state OUTFILE.resume after
+    // each pass once SECONDS have passed since the last, and both when the render is
+    // stopped (SIGINT/SIGTERM): a killed render loses at most one interval.
+    const std::string resumeOut = outFile + ".resume";
+    bool resumeWarned = false;
+    if (checkpointEvery >= 0.0 && root) {
+        ro.snapshotDue = [&](int, double t, bool stop) { return stop || checkpoint.due(t); };
+        ro.onSnapshot = [&](const RenderSnapshot& snap, bool resumable, const Film& film) {
+            checkpoint.write(snap.spp, snap.seconds, film);
+            std::string werr;
+            if (!resumable) {
+                werr = "no restart state: " + snap.guide;
+            } else if (writeResumeFile(resumeOut, fingerprint, snap, &werr)) {
+                return;
+            }
+            if (!resumeWarned)
+                std::fprintf(stderr, "%s: warning: %s\n", resumeOut.c_str(), werr.c_str());
+            resumeWarned = true;
+        };
+    }
+    if (cancelAtSpp > 0)
+        ro.onPass = chainOnPass(std::move(ro.onPass), [&](int passSpp, double, const Film&) {
+            if (passSpp >= cancelAtSpp) gCancel.store(true);
         });
     if (ranks) {
         if (ranks->size() > 1 && guideSettings.autoSpp > 0) {

@@ -37,6 +37,11 @@ public:
         data.append(s);
     }
     void raw(const char* p, size_t n) { data.append(p, n); }
+    // A byte string of any length (u64 length, then the bytes).
+    void blob(const std::string& s) {
+        u64(uint64_t(s.size()));
+        data.append(s);
+    }
     std::string data;
 
 private:
@@ -77,6 +82,17 @@ public:
         }
         std::string s = data_.substr(pos_, n);
         pos_ += n;
+        return s;
+    }
+    // Writer::blob's byte string (empty and !ok() if it runs past the end).
+    std::string blob() {
+        const uint64_t n = u64();
+        if (!ok_ || remaining() < n) {
+            ok_ = false;
+            return {};
+        }
+        std::string s = data_.substr(pos_, size_t(n));
+        pos_ += size_t(n);
         return s;
     }
     bool ok() const { return ok_; }

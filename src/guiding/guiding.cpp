@@ -51,6 +51,16 @@ bool GuidingField::load(const std::string&, std::string* error) {
     return false;
 }
 
+bool GuidingField::saveState(std::string*, std::string* error) const {
+    *error = "this guiding backend cannot save its learning state";
+    return false;
+}
+
+bool GuidingField::loadState(const std::string&, std::string* error) {
+    *error = "this guiding backend cannot restore a learning state";
+    return false;
+}
+
 namespace {
 
 // Parses a whole string as a finite double.

@@ -232,6 +232,16 @@ public:
     // same backend, the same scene (bounds, total area) and the same structure (points or
     // voxel size, strata); otherwise false, *error says why, and the field is unchanged.
     virtual bool load(const std::string& path, std::string* error);
+
+    // ---- Resuming a render (render/resume.h): the complete learning state, between passes.
+    // saveState gives, as bytes, what save() writes and what a saved field leaves out (the
+    // learned selections of mix=learn), so that a field of the same backend, parameters and
+    // scene that restores it with loadState answers every query as this one does and learns
+    // on alike: a resumed render continues as the uninterrupted one would. loadState checks
+    // what load() checks; on failure (false, *error says why) the field is unspecified and
+    // the caller must not render with it. Default: unsupported.
+    virtual bool saveState(std::string* state, std::string* error) const;
+    virtual bool loadState(const std::string& state, std::string* error);
 };
 
 // The guide at one vertex: the field's region there (GuidingField::guide), and what the

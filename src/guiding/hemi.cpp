@@ -499,6 +499,10 @@ bool HemiField::save(const std::string& path, std::string* error) const {
         *error = "hemi with directions=tree cannot be saved yet";
         return false;
     }
+    return fieldio::writeFile(path, serialize(), error);
+}
+
+std::string HemiField::serialize() const {
     fieldio::Writer w;
     w.raw(fieldio::kMagic, 8);
     w.u32(fieldio::kVersion);
@@ -521,8 +525,7 @@ bool HemiField::save(const std::string& path, std::string* error) const {
     w.data.reserve(w.data.size() + q.size() * 16);
     for (double d : q) w.f64(d);
     for (uint64_t v : visits) w.u64(v);
-    if (!fieldio::writeFile(path, w.data, error)) return false;
-    return true;
+    return std::move(w.data);
 }
 
 bool HemiField::load(const std::string& path, std::string* error) {
@@ -542,14 +545,21 @@ bool HemiField::load(const std::string& path, std::string* error) {
     }
     std::string data;
     if (!fieldio::readFile(path, &data, error)) return false;
+    return loadBytes(data, path, error);
+}
+
+bool HemiField::loadBytes(const std::string& data, const std::string& name,
+                          std::string* error) {
     auto fail = [&](const std::string& why) {
-        *error = "'" + path + "': " + why;
+        *error = "'" + name + "': " + why;
         return false;
     };
+    if (data.size() < 16 || std::memcmp(data.data(), fieldio::kMagic, 8) != 0)
+        return fail("not a saved hemi field");
     fieldio::Reader r(data);
     r.skip(8);
     const uint32_t version = r.u32();
-    r.str();
+    if (r.str(32) != "hemi") return fail("not a saved hemi field");
     if (version != fieldio::kVersion) return fail("unsupported version " + std::to_string(version));
     const glm::vec3 bmin = r.vec3(), bmax = r.vec3();
     const double area = r.f64();
@@ -584,6 +594,39 @@ bool HemiField::load(const std::string& path, std::string* error) {
     if (!r.ok()) return fail("truncated tables");
     table_.assign(std::move(q), std::move(visits), policy());
     table_.stats() = s;
+    return true;
+}
+
+bool HemiField::saveState(std::string* state, std::string* error) const {
+    if (trees_) {
+        *error = "hemi with directions=tree cannot save its learning state yet";
+        return false;
+    }
+    fieldio::Writer w;
+    w.blob(serialize());
+    table_.selection().saveState(w);
+    *state = std::move(w.data);
+    return true;
+}
+
+bool HemiField::loadState(const std::string& state, std::string* error) {
+    if (trees_) {
+        *error = "hemi with directions=tree cannot restore a learning state yet";
+        return false;
+    }
+    fieldio::Reader r(state);
+    const std::string tables = r.blob();
+    if (!r.ok()) {
+        *error = "truncated hemi state";
+        return false;
+    }
+    if (!loadBytes(tables, "hemi state", error)) return false;
+    if (!table_.selection().loadState(r) || r.remaining() != 0) {
+        *error = "corrupt selection state of the hemi field";
+        return false;
+    }
+    table_.stats().selectionRegions = table_.selection().learnedRegions();
+    table_.stats().selectionMean = table_.selection().meanSelection();
     return true;
 }
 

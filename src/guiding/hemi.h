@@ -138,6 +138,9 @@ public:
     // Little-endian binary file, docs/GUIDE_FILES.md.
     bool save(const std::string& path, std::string* error) const override;
     bool load(const std::string& path, std::string* error) override;
+    // The saved field's bytes and the selection learner's state (directions=tree: refused).
+    bool saveState(std::string* state, std::string* error) const override;
+    bool loadState(const std::string& state, std::string* error) override;
 
     // Inspection (tests, tools).
     // Bytes of the per-pass record buffers and endPass scratch (not counted in bytes()).
@@ -190,6 +193,10 @@ public:
     const std::vector<float>& cdfTable() const { return table_.cdfTable(); }
 
 private:
+    // The saved field's bytes (save() writes them to a file), and their loading (`name`
+    // names them in messages).
+    std::string serialize() const;
+    bool loadBytes(const std::string& data, const std::string& name, std::string* error);
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;
     // The factor of stratum j's Q in the policy: its centre's cosine, or 1 without the cosine

@@ -76,6 +76,41 @@ void SelectionLearner::update(size_t r, const double* add, double count) {
     selection_[r] = best < 0 ? -1.f : candidate(best);
 }
 
+void SelectionLearner::saveState(fieldio::Writer& w) const {
+    w.u64(regions_);
+    w.u32(selection_.empty() ? 0u : 1u);
+    if (selection_.empty()) return;
+    for (double v : sums_) w.f64(v);
+    for (double v : weights_) w.f64(v);
+    for (float v : selection_) w.f32(v);
+}
+
+bool SelectionLearner::loadState(fieldio::Reader& r) {
+    const uint64_t regions = r.u64();
+    const uint32_t allocated = r.u32();
+    if (!r.ok() || regions != regions_ || allocated > 1) return false;
+    if (allocated == 0) {
+        sums_.clear();
+        weights_.clear();
+        selection_.clear();
+        return true;
+    }
+    if (r.remaining() < regions_ * (kCandidates * 8 + 8 + 4)) return false;
+    std::vector<double> sums(regions_ * kCandidates), weights(regions_);
+    std::vector<float> selection(regions_);
+    for (double& v : sums) v = r.f64();
+    for (double& v : weights) v = r.f64();
+    for (float& v : selection) {
+        v = r.f32();
+        if (!(v == -1.f || (v >= 0.f && v < 1.f))) return false;
+    }
+    if (!r.ok()) return false;
+    sums_ = std::move(sums);
+    weights_ = std::move(weights);
+    selection_ = std::move(selection);
+    return true;
+}
+
 size_t SelectionLearner::pendingSamples() const {
     size_t total = 0;
     for (const SlotBuffer& s : slots_) total += s.samples.size();

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "guiding/field_io.h"
 #include "guiding/guiding.h"
 #include "guiding/slot_merge.h"
 
@@ -63,6 +64,12 @@ public:
     double meanSelection() const;
     size_t bytes() const;
     size_t scratchBytes() const;
+
+    // The learned state (regions, decayed sums and weights, selections) between passes, for
+    // GuidingField::saveState: loadState restores it into a learner of as many regions
+    // (false, and the learner unchanged, for another count or corrupt data).
+    void saveState(fieldio::Writer& w) const;
+    bool loadState(fieldio::Reader& r);
 
 private:
     struct Sample {

@@ -7,7 +7,10 @@
 #include <limits>
 #include <optional>
 
+#include <sstream>
+
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tree/ValueAccessor.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -535,58 +538,66 @@ GuidingStats VdbField::stats() const {
 
 // ---- Save / load: an OpenVDB file with one Int32Grid and the tables as grid metadata ----
 
+std::unique_ptr<VdbField::Grid> VdbField::savedGrid() const {
+    openvdb::Int32Grid::Ptr copy =
+        openvdb::gridPtrCast<openvdb::Int32Grid>(grid_->grid->copyGrid());  // shares the tree
+    copy->insertMeta("rlpbrt:format", openvdb::StringMetadata("rlpbrt guiding field"));
+    copy->insertMeta("rlpbrt:version", openvdb::Int32Metadata(kFileVersion));
+    copy->insertMeta("rlpbrt:backend", openvdb::StringMetadata("vdb"));
+    copy->insertMeta("rlpbrt:dirs", openvdb::StringMetadata(params_.sphere ? "sphere" : "hemi"));
+    copy->insertMeta("rlpbrt:bounds_min",
+                     openvdb::Vec3SMetadata(openvdb::Vec3s(sceneMin_.x, sceneMin_.y, sceneMin_.z)));
+    copy->insertMeta("rlpbrt:bounds_max",
+                     openvdb::Vec3SMetadata(openvdb::Vec3s(sceneMax_.x, sceneMax_.y, sceneMax_.z)));
+    copy->insertMeta("rlpbrt:area", openvdb::DoubleMetadata(sceneArea_));
+    copy->insertMeta("rlpbrt:voxel_size", openvdb::DoubleMetadata(voxelSize_));
+    copy->insertMeta("rlpbrt:points", openvdb::Int64Metadata(int64_t(points_)));
+    copy->insertMeta("rlpbrt:strata", openvdb::Vec2IMetadata(openvdb::Vec2i(params_.cols, params_.rows)));
+    copy->insertMeta("rlpbrt:normals_max", openvdb::Int32Metadata(params_.normals));
+    copy->insertMeta("rlpbrt:normal_angle", openvdb::DoubleMetadata(params_.normalAngleDeg));
+    fieldio::Writer counts, normals;
+    for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
+        counts.u32(clusterStart_[v + 1] - clusterStart_[v]);
+    for (const glm::vec3& n : clusterNormals_) normals.vec3(n);
+    copy->insertMeta("rlpbrt:clusters", openvdb::StringMetadata(counts.data));
+    copy->insertMeta("rlpbrt:normals", openvdb::StringMetadata(normals.data));
+    copy->insertMeta("rlpbrt:q", openvdb::StringMetadata(fieldio::packDoubles(table_.denseQ())));
+    copy->insertMeta("rlpbrt:visits",
+                     openvdb::StringMetadata(fieldio::packU64(table_.denseVisits())));
+    const GuidingStats& s = table_.stats();
+    copy->insertMeta("rlpbrt:passes", openvdb::Int64Metadata(int64_t(s.passes)));
+    copy->insertMeta("rlpbrt:records", openvdb::Int64Metadata(int64_t(s.records)));
+    copy->insertMeta("rlpbrt:rejected_targets", openvdb::Int64Metadata(int64_t(s.rejectedTargets)));
+    copy->insertMeta("rlpbrt:rejected_records", openvdb::Int64Metadata(int64_t(s.rejectedRecords)));
+    if (volume_) {
+        fieldio::Writer coords, counters;
+        for (const glm::ivec3& c : volume_->cellCoords())
+            coords.u32(uint32_t(c.x)), coords.u32(uint32_t(c.y)), coords.u32(uint32_t(c.z));
+        const GuidingStats& vs = volume_->stats();
+        counters.u64(vs.records), counters.u64(vs.rejectedTargets),
+            counters.u64(vs.rejectedRecords);
+        copy->insertMeta("rlpbrt:volume_voxel_size", openvdb::DoubleMetadata(volume_->voxelSize()));
+        copy->insertMeta("rlpbrt:volume_strata", openvdb::Vec2IMetadata(openvdb::Vec2i(
+                                                     params_.volumeCols, params_.volumeRows)));
+        copy->insertMeta("rlpbrt:volume_cells", openvdb::StringMetadata(coords.data));
+        copy->insertMeta("rlpbrt:volume_q",
+                         openvdb::StringMetadata(fieldio::packDoubles(volume_->table().denseQ())));
+        copy->insertMeta("rlpbrt:volume_visits",
+                         openvdb::StringMetadata(fieldio::packU64(volume_->table().denseVisits())));
+        copy->insertMeta("rlpbrt:volume_counters", openvdb::StringMetadata(counters.data));
+    }
+    auto saved = std::make_unique<Grid>();
+    saved->grid = copy;
+    return saved;
+}
+
 bool VdbField::save(const std::string& path, std::string* error) const {
     try {
-        openvdb::GridBase::Ptr copy = grid_->grid->copyGrid();  // shares the tree
-        copy->insertMeta("rlpbrt:format", openvdb::StringMetadata("rlpbrt guiding field"));
-        copy->insertMeta("rlpbrt:version", openvdb::Int32Metadata(kFileVersion));
-        copy->insertMeta("rlpbrt:backend", openvdb::StringMetadata("vdb"));
-        copy->insertMeta("rlpbrt:dirs", openvdb::StringMetadata(params_.sphere ? "sphere" : "hemi"));
-        copy->insertMeta("rlpbrt:bounds_min",
-                         openvdb::Vec3SMetadata(openvdb::Vec3s(sceneMin_.x, sceneMin_.y, sceneMin_.z)));
-        copy->insertMeta("rlpbrt:bounds_max",
-                         openvdb::Vec3SMetadata(openvdb::Vec3s(sceneMax_.x, sceneMax_.y, sceneMax_.z)));
-        copy->insertMeta("rlpbrt:area", openvdb::DoubleMetadata(sceneArea_));
-        copy->insertMeta("rlpbrt:voxel_size", openvdb::DoubleMetadata(voxelSize_));
-        copy->insertMeta("rlpbrt:points", openvdb::Int64Metadata(int64_t(points_)));
-        copy->insertMeta("rlpbrt:strata", openvdb::Vec2IMetadata(openvdb::Vec2i(params_.cols, params_.rows)));
-        copy->insertMeta("rlpbrt:normals_max", openvdb::Int32Metadata(params_.normals));
-        copy->insertMeta("rlpbrt:normal_angle", openvdb::DoubleMetadata(params_.normalAngleDeg));
-        fieldio::Writer counts, normals;
-        for (size_t v = 0; v + 1 < clusterStart_.size(); ++v)
-            counts.u32(clusterStart_[v + 1] - clusterStart_[v]);
-        for (const glm::vec3& n : clusterNormals_) normals.vec3(n);
-        copy->insertMeta("rlpbrt:clusters", openvdb::StringMetadata(counts.data));
-        copy->insertMeta("rlpbrt:normals", openvdb::StringMetadata(normals.data));
-        copy->insertMeta("rlpbrt:q", openvdb::StringMetadata(fieldio::packDoubles(table_.denseQ())));
-        copy->insertMeta("rlpbrt:visits",
-                         openvdb::StringMetadata(fieldio::packU64(table_.denseVisits())));
-        const GuidingStats& s = table_.stats();
-        copy->insertMeta("rlpbrt:passes", openvdb::Int64Metadata(int64_t(s.passes)));
-        copy->insertMeta("rlpbrt:records", openvdb::Int64Metadata(int64_t(s.records)));
-        copy->insertMeta("rlpbrt:rejected_targets", openvdb::Int64Metadata(int64_t(s.rejectedTargets)));
-        copy->insertMeta("rlpbrt:rejected_records", openvdb::Int64Metadata(int64_t(s.rejectedRecords)));
-        if (volume_) {
-            fieldio::Writer coords, counters;
-            for (const glm::ivec3& c : volume_->cellCoords())
-                coords.u32(uint32_t(c.x)), coords.u32(uint32_t(c.y)), coords.u32(uint32_t(c.z));
-            const GuidingStats& vs = volume_->stats();
-            counters.u64(vs.records), counters.u64(vs.rejectedTargets),
-                counters.u64(vs.rejectedRecords);
-            copy->insertMeta("rlpbrt:volume_voxel_size", openvdb::DoubleMetadata(volume_->voxelSize()));
-            copy->insertMeta("rlpbrt:volume_strata", openvdb::Vec2IMetadata(openvdb::Vec2i(
-                                                         params_.volumeCols, params_.volumeRows)));
-            copy->insertMeta("rlpbrt:volume_cells", openvdb::StringMetadata(coords.data));
-            copy->insertMeta("rlpbrt:volume_q",
-                             openvdb::StringMetadata(fieldio::packDoubles(volume_->table().denseQ())));
-            copy->insertMeta("rlpbrt:volume_visits",
-                             openvdb::StringMetadata(fieldio::packU64(volume_->table().denseVisits())));
-            copy->insertMeta("rlpbrt:volume_counters", openvdb::StringMetadata(counters.data));
-        }
+        const std::unique_ptr<Grid> saved = savedGrid();
         const std::string tmp = path + ".tmp";
         {
             openvdb::io::File file(tmp);
-            file.write(openvdb::GridCPtrVec{copy});
+            file.write(openvdb::GridCPtrVec{saved->grid});
             file.close();
         }
         if (std::rename(tmp.c_str(), path.c_str()) != 0) {
@@ -630,8 +641,15 @@ bool VdbField::load(const std::string& path, std::string* error) {
         *error = "'" + path + "': the guiding grid is not an Int32Grid";
         return false;
     }
+    Grid saved;
+    saved.grid = grid;
+    return loadGrid(saved, path, error);
+}
+
+bool VdbField::loadGrid(Grid& saved, const std::string& name, std::string* error) {
+    openvdb::Int32Grid::Ptr grid = saved.grid;
     auto fail = [&](const std::string& why) {
-        *error = "'" + path + "': " + why;
+        *error = "'" + name + "': " + why;
         return false;
     };
     try {
@@ -779,6 +797,63 @@ bool VdbField::load(const std::string& path, std::string* error) {
     } catch (const std::exception& e) {
         return fail(std::string("missing or bad metadata: ") + e.what());
     }
+    return true;
+}
+
+// ---- Resume state: the saved field as an OpenVDB stream, then the selection learners ----
+
+bool VdbField::saveState(std::string* state, std::string* error) const {
+    fieldio::Writer w;
+    try {
+        std::ostringstream out(std::ios::binary);
+        openvdb::io::Stream(out).write(openvdb::GridCPtrVec{savedGrid()->grid});
+        w.blob(out.str());
+    } catch (const std::exception& e) {
+        *error = std::string("cannot serialise the vdb field: ") + e.what();
+        return false;
+    }
+    table_.selection().saveState(w);
+    w.u32(volume_ ? 1u : 0u);
+    if (volume_) volume_->selection().saveState(w);
+    *state = std::move(w.data);
+    return true;
+}
+
+bool VdbField::loadState(const std::string& state, std::string* error) {
+    fieldio::Reader r(state);
+    const std::string stream = r.blob();
+    if (!r.ok()) {
+        *error = "truncated vdb state";
+        return false;
+    }
+    Grid saved;
+    try {
+        std::istringstream in(stream, std::ios::binary);
+        openvdb::io::Stream vdbStream(in);
+        openvdb::GridPtrVecPtr grids = vdbStream.getGrids();
+        for (const openvdb::GridBase::Ptr& g : grids ? *grids : openvdb::GridPtrVec())
+            if (g && g->getName() == kGridName) saved.grid = openvdb::gridPtrCast<openvdb::Int32Grid>(g);
+    } catch (const std::exception& e) {
+        *error = std::string("corrupt vdb state: ") + e.what();
+        return false;
+    }
+    if (!saved.grid) {
+        *error = "corrupt vdb state: no guiding grid";
+        return false;
+    }
+    if (!loadGrid(saved, "vdb state", error)) return false;
+    if (!table_.selection().loadState(r)) {
+        *error = "corrupt selection state of the vdb field";
+        return false;
+    }
+    const uint32_t hasVolume = r.u32();
+    if (!r.ok() || hasVolume != (volume_ ? 1u : 0u) ||
+        (volume_ && !volume_->selection().loadState(r)) || r.remaining() != 0) {
+        *error = "corrupt medium selection state of the vdb field";
+        return false;
+    }
+    table_.stats().selectionRegions = table_.selection().learnedRegions();
+    table_.stats().selectionMean = table_.selection().meanSelection();
     return true;
 }
 

@@ -96,6 +96,9 @@ public:
     GuidingStats stats() const override;
     bool save(const std::string& path, std::string* error) const override;
     bool load(const std::string& path, std::string* error) override;
+    // The saved field (an OpenVDB stream) and the selection learners' states.
+    bool saveState(std::string* state, std::string* error) const override;
+    bool loadState(const std::string& state, std::string* error) override;
 
     // Inspection (tests, tools).
     const VdbParams& params() const { return params_; }
@@ -155,6 +158,10 @@ private:
     int volumeCell(int region) const {
         return region >= 0 && volume_ && size_t(region) >= table_.regions() ? region - int(table_.regions()) : -1;
     }
+    // save()'s grid: a copy of the regions' grid (sharing its tree) with the tables as
+    // metadata; and load()'s reading of such a grid (`name` names it in messages).
+    std::unique_ptr<Grid> savedGrid() const;
+    bool loadGrid(Grid& saved, const std::string& name, std::string* error);
     void buildPolicy(const double* q, float* cdf) const;
     StrataTable::PolicyBuilder policy() const;
     void buildFrames();

@@ -11,7 +11,10 @@ Checkpointer::Checkpointer(std::string path, double interval,
     : path_(std::move(path)), interval_(interval), metadata_(std::move(metadata)) {}
 
 void Checkpointer::onPass(int spp, double seconds, const Film& film) {
-    if (seconds - last_ < interval_) return;
+    if (due(seconds)) write(spp, seconds, film);
+}
+
+void Checkpointer::write(int spp, double seconds, const Film& film) {
     last_ = seconds;
     std::string err;
     if (writeImage(path_, film.toImage(), metadata_(spp, seconds), &err)) {

@@ -25,6 +25,12 @@ public:
     // The RenderOptions::onPass hook: writes a checkpoint when one is due. A failed write is
     // reported once (a warning on stderr) and the render goes on.
     void onPass(int spp, double seconds, const Film& film);
+    // Whether a checkpoint is due at render time `seconds`, and the writing of one (onPass
+    // is both; the resume snapshots of render/resume.h ask due() and then write()).
+    bool due(double seconds) const { return seconds - last_ >= interval_; }
+    void write(int spp, double seconds, const Film& film);
+    // The render time of the last checkpoint (a resumed render's start).
+    void setLast(double seconds) { last_ = seconds; }
 
     int written() const { return written_; }
     int lastSpp() const { return lastSpp_; }

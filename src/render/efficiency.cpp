@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "guiding/field_io.h"
+
 namespace rlpbrt {
 
 PassMoments::PassMoments(const Bounds2i& bounds, size_t maxPixels) : bounds_(bounds) {
@@ -89,6 +91,25 @@ double PassMoments::relativeVariance(const PassMoments& reference) const {
         if (counts[g] > 0) means[groups++] = sums[g] / double(counts[g]);
     std::nth_element(means, means + groups / 2, means + groups);
     return means[groups / 2];
+}
+
+std::string PassMoments::state() const {
+    guiding::fieldio::Writer w;
+    w.u64(count_.size());
+    for (float v : mean_) w.f32(v);
+    for (float v : var_) w.f32(v);
+    for (int c : count_) w.u32(uint32_t(c));
+    return std::move(w.data);
+}
+
+bool PassMoments::setState(const std::string& state) {
+    guiding::fieldio::Reader r(state);
+    const uint64_t n = r.u64();
+    if (!r.ok() || n != count_.size() || r.remaining() != n * 28) return false;
+    for (float& v : mean_) v = r.f32();
+    for (float& v : var_) v = r.f32();
+    for (int& c : count_) c = int(r.u32());
+    return r.ok();
 }
 
 }  // namespace rlpbrt

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "render/film.h"
@@ -40,6 +41,12 @@ public:
     // plain rendering better on veach-bidir and breakfast, where guiding wins), and a plain
     // mean is decided by single samples (docs/BENCHMARKS_HISTORY.md, session 5, "A guided-or-plain trial").
     double relativeVariance(const PassMoments& reference) const;
+
+    // The tracked pixels' means, variances and counts as bytes (a resumed render's auto
+    // trial, render/resume.h), and their restoring into moments over the same rectangle
+    // (false, and nothing changed, if the sizes do not match).
+    std::string state() const;
+    bool setState(const std::string& state);
 
 private:
     long slot(int x, int y) const;

@@ -214,4 +214,27 @@ void Film::clear() {
     std::fill(pixels_.begin(), pixels_.end(), Pixel());
 }
 
+std::vector<double> Film::sums() const {
+    static_assert(sizeof(Pixel) == 4 * sizeof(double), "Film::sums needs plain doubles");
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<double> out(pixels_.size() * 4);
+    for (size_t i = 0; i < pixels_.size(); ++i) {
+        const Pixel& p = pixels_[i];
+        out[4 * i] = p.contrib[0], out[4 * i + 1] = p.contrib[1], out[4 * i + 2] = p.contrib[2];
+        out[4 * i + 3] = p.weightSum;
+    }
+    return out;
+}
+
+bool Film::setSums(const std::vector<double>& sums) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (sums.size() != pixels_.size() * 4) return false;
+    for (size_t i = 0; i < pixels_.size(); ++i) {
+        Pixel& p = pixels_[i];
+        p.contrib[0] = sums[4 * i], p.contrib[1] = sums[4 * i + 1], p.contrib[2] = sums[4 * i + 2];
+        p.weightSum = sums[4 * i + 3];
+    }
+    return true;
+}
+
 }  // namespace rlpbrt

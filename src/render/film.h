@@ -160,6 +160,11 @@ public:
     double weightSum(int x, int y) const;
     // Zeroes all pixel sums.
     void clear();
+    // The stored pixels' exact sums, 4 doubles per pixel (sum(w L) RGB, sum(w)), row-major
+    // over pixelBounds(): what a resumed render continues from (render/resume.h). setSums
+    // replaces them (false, and the film unchanged, if the count does not match).
+    std::vector<double> sums() const;
+    bool setSums(const std::vector<double>& sums);
 
 private:
     struct Pixel {

@@ -86,6 +86,13 @@ public:
                              std::clamp(y - bounds_.pMin.y, 0, h_ - 1))];
     }
 
+    // The estimates as they stand (empty until the first refresh), and their restoring
+    // (a resumed render's; ignored if the size does not match).
+    const std::vector<float>& values() const { return values_; }
+    void setValues(const std::vector<float>& v) {
+        if (v.empty() || v.size() == size_t(w_) * size_t(h_)) values_ = v;
+    }
+
 private:
     size_t index(int x, int y) const { return size_t(y) * size_t(w_) + size_t(x); }
     Bounds2i bounds_;
@@ -171,6 +178,70 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     long long pixelsPerPass = 0;
     for (const auto& t : tiles) pixelsPerPass += (long long)t.area();
     int pass = 0;
+    // Resuming (render/resume.h): the state after the snapshot's last pass. The statistics
+    // of the passes before are added after the ranks' sums (they are all ranks' already).
+    PathStats earlierStats;
+    if (const RenderSnapshot* snap = options.resume) {
+        film.setSums(snap->film);
+        estimates.setValues(snap->estimates);
+        result.spp = snap->spp;
+        pass = snap->passes;
+        start -= snap->seconds;
+        samplesDone = pixelsPerPass * snap->spp;
+        earlierStats = snap->stats;
+        result.guideEndPassSeconds = snap->guideEndPassSeconds;
+        // The auto trial where it stood (a state without one, or after it: over).
+        trial = snap->trial == 1 ? Trial::Pending : snap->trial == 2 ? Trial::MeasurePlain
+                                                                      : Trial::Done;
+        if (trial == Trial::Done || !history || !history->setState(snap->trialHistory))
+            trial = Trial::Done, history.reset();
+        if (trial == Trial::MeasurePlain) {
+            guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
+            guidedSecondsPerSample = snap->trialGuidedSecondsPerSample;
+            guidedCount = snap->trialGuidedCount;
+            if (!guidedMoments->setState(snap->trialGuided))
+                trial = Trial::Done, history.reset(), guidedMoments.reset();
+        }
+        if (field) {
+            guided = snap->guided;
+            result.autoTrial.ran = snap->autoRan;
+            result.autoTrial.keptGuiding = snap->autoKept;
+            result.autoTrial.guidedSpp = snap->autoGuidedSpp;
+            result.autoTrial.guidedCost = snap->autoGuidedCost;
+            result.autoTrial.plainCost = snap->autoPlainCost;
+            if (!guided) plainIntegrator = std::make_unique<PathIntegrator>(scene, GuideSettings());
+            if (snap->frozen) {
+                GuideSettings frozen = options.guide;
+                frozen.learn = false;
+                frozenIntegrator = std::make_unique<PathIntegrator>(scene, frozen);
+                result.learningSpp = snap->learningSpp;
+            }
+        }
+    }
+    // The path statistics so far, of all ranks (a collective with ranks).
+    auto statsSoFar = [&] {
+        PathStats s;
+        for (const auto& t : stats) s.add(t);
+        if (ranks) {
+            double sums[9] = {double(s.paths),
+                              double(s.rays),
+                              double(s.vertices),
+                              double(s.zeroRadiancePaths),
+                              double(s.nonFinite),
+                              double(s.guidedVertices),
+                              double(s.timedGuidedVertices),
+                              double(s.guideClock.nanos),
+                              double(s.guideClock.calls)};
+            ranks->sumDoubles(sums, 9);
+            s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]);
+            s.vertices = uint64_t(sums[2]);
+            s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
+            s.guidedVertices = uint64_t(sums[5]), s.timedGuidedVertices = uint64_t(sums[6]);
+            s.guideClock.nanos = uint64_t(sums[7]), s.guideClock.calls = uint64_t(sums[8]);
+        }
+        s.add(earlierStats);
+        return s;
+    };
     for (;;) {
         int count = guided ? std::clamp(result.spp / 2, 1, kMaxGuidedPass) : 1;
         if (trial == Trial::MeasurePlain) count = guidedCount;
@@ -332,8 +403,46 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (options.progress)
             printProgress(pass, result.spp, totalSpp, elapsed, options.timeBudget,
                           samplesDone / std::max(elapsed, 1e-9));
-        bool stop = options.cancel && options.cancel->load();
-        if (ranks) ranks->broadcast(&stop, sizeof(stop));  // rank 0 decides
+        // Rank 0 decides whether to stop, and whether to take a snapshot for resuming
+        // (render/resume.h) where its hook wants one.
+        bool decisions[2] = {false, false};  // stop, snapshot
+        if (!ranks || ranks->rank() == 0) {
+            decisions[0] = options.cancel && options.cancel->load();
+            decisions[1] = options.snapshotDue &&
+                           options.snapshotDue(result.spp, elapsed, decisions[0]);
+        }
+        if (ranks) ranks->broadcast(decisions, sizeof(decisions));
+        const bool stop = decisions[0];
+        if (decisions[1]) {
+            RenderSnapshot snap;
+            snap.stats = statsSoFar();  // (all ranks take part)
+            if ((!ranks || ranks->rank() == 0) && options.onSnapshot) {
+                snap.passes = pass;
+                snap.spp = result.spp;
+                snap.seconds = elapsed;
+                snap.guideEndPassSeconds = result.guideEndPassSeconds;
+                snap.ranks = ranks ? ranks->size() : 1;
+                snap.guided = guided;
+                snap.autoRan = result.autoTrial.ran;
+                snap.autoKept = result.autoTrial.keptGuiding;
+                snap.autoGuidedSpp = result.autoTrial.guidedSpp;
+                snap.autoGuidedCost = result.autoTrial.guidedCost;
+                snap.autoPlainCost = result.autoTrial.plainCost;
+                snap.frozen = frozenIntegrator != nullptr;
+                snap.learningSpp = result.learningSpp;
+                snap.trial = trial == Trial::Pending ? 1 : trial == Trial::MeasurePlain ? 2 : 0;
+                if (history) snap.trialHistory = history->state();
+                if (guidedMoments) snap.trialGuided = guidedMoments->state();
+                snap.trialGuidedSecondsPerSample = guidedSecondsPerSample;
+                snap.trialGuidedCount = guidedCount;
+                snap.film = film.sums();
+                snap.estimates = estimates.values();
+                std::string err;
+                const bool resumable = !field || field->saveState(&snap.guide, &err);
+                if (!resumable) snap.guide = err;  // (the reason, for the hook's message)
+                options.onSnapshot(snap, resumable, film);
+            }
+        }
         if (stop) {
             result.cancelled = true;
             break;
@@ -343,24 +452,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     if (!frozenIntegrator) result.learningSpp = result.autoTrial.guidedSpp;
     if (options.progress) std::fprintf(stderr, "\n");
     result.seconds = now() - start;
-    for (const auto& s : stats) result.stats.add(s);
+    result.stats = statsSoFar();
     result.passes = pass;
     if (ranks) {
-        PathStats& s = result.stats;
-        double sums[9] = {double(s.paths),
-                          double(s.rays),
-                          double(s.vertices),
-                          double(s.zeroRadiancePaths),
-                          double(s.nonFinite),
-                          double(s.guidedVertices),
-                          double(s.timedGuidedVertices),
-                          double(s.guideClock.nanos),
-                          double(s.guideClock.calls)};
-        ranks->sumDoubles(sums, 9);
-        s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]), s.vertices = uint64_t(sums[2]);
-        s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
-        s.guidedVertices = uint64_t(sums[5]), s.timedGuidedVertices = uint64_t(sums[6]);
-        s.guideClock.nanos = uint64_t(sums[7]), s.guideClock.calls = uint64_t(sums[8]);
         result.ranks = ranks->size();
         result.bytesExchanged = ranks->bytesExchanged();
         result.secondsExchanging = ranks->secondsExchanging() - exchangeBefore;

@@ -9,6 +9,7 @@
 #include "render/distributed.h"
 #include "render/image.h"
 #include "render/integrator.h"
+#include "render/resume.h"
 #include "render/scene.h"
 
 namespace rlpbrt {
@@ -27,6 +28,20 @@ struct RenderOptions {
     // to every rank (GuidingField::endPassShared), and rank 0's clock and cancel flag decide
     // for all. Only rank 0's result image and onPass calls are meaningful.
     Ranks* ranks = nullptr;
+    // Resuming (render/resume.h): continue after the snapshot's last pass, from its film sums,
+    // counters, time (a time budget counts it) and loop state, as the render that took it
+    // would have gone on. The caller has restored the snapshot's guide state into guide.field
+    // (GuidingField::loadState) and checked that scene and options match. Every rank passes
+    // the same snapshot.
+    const RenderSnapshot* resume = nullptr;
+    // Snapshots: after each pass and its onPass, rank 0 asks snapshotDue(spp, seconds, stop)
+    // (stop: the render stops after this pass, cancelled); where it says yes, the statistics
+    // are summed over the ranks and onSnapshot gets the snapshot and the film on rank 0.
+    // resumable false: the snapshot cannot be resumed from (the guide cannot save its state),
+    // and its `guide` holds the reason.
+    std::function<bool(int spp, double seconds, bool stop)> snapshotDue;
+    std::function<void(const RenderSnapshot& snapshot, bool resumable, const Film& film)>
+        onSnapshot;
 };
 
 struct RenderResult {

@@ -1,5 +1,6 @@
 // No lost work: `--checkpoint SECONDS` writes the image so far during the render (atomically,
-// with its real spp in the metadata), and the final image replaces it at the end.
+// with its real spp in the metadata), and the final image replaces it at the end; the restart
+// state OUTFILE.resume is written with it (tests/render/resume_test.cpp).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -82,7 +83,10 @@ TEST(Checkpoint, ImageSoFarIsWrittenDuringTheRender) {
     auto c = json.find("\"checkpoints\": ");
     ASSERT_NE(c, std::string::npos) << json;
     EXPECT_GE(std::stoi(json.substr(c + 15)), 2) << json;
+    // With each checkpoint, the restart state (docs/DISTRIBUTED.md, "Resume").
+    EXPECT_TRUE(exists(out + ".resume"));
     std::remove(out.c_str());
+    std::remove((out + ".resume").c_str());
     std::remove(stats.c_str());
     EXPECT_EQ(rmdir(dir.c_str()), 0) << "files left in " << dir;
 }

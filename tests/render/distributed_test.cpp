@@ -175,6 +175,64 @@ INSTANTIATE_TEST_SUITE_P(Backends, TwoRanks,
                              return std::string(i.param.name);
                          });
 
+// Resume on two ranks (docs/DISTRIBUTED.md, "Resume"): a job stopped after 3 spp (as by
+// SIGTERM; rank 0 writes the image and OUTFILE.resume) and resumed by a second job, whose
+// ranks each read the state, gives the uninterrupted job's image bit for bit.
+class TwoRanksResume : public ::testing::TestWithParam<Case> {};
+
+TEST_P(TwoRanksResume, EqualsUninterrupted) {
+    REQUIRE_MPIRUN();
+    const Case c = GetParam();
+    const std::string dir = tempDir();
+    const std::string scene = writeRoom(dir + "/room.pbrt", c.fog);
+    const std::string args = scene + " --spp 8 --seed 3 --quiet --nthreads 1 --guide " +
+                             c.guide + " " + c.extra;
+    CliRun whole = rlpbrt::test::runCommand(mpirun(2) + args + " -o " + dir + "/whole.pfm");
+    ASSERT_EQ(whole.status, 0) << whole.output;
+    CliRun first = rlpbrt::test::runCommand(mpirun(2) + args +
+                                            " --checkpoint 0 --cancel-at-spp 3 -o " + dir +
+                                            "/out.pfm");
+    EXPECT_NE(first.status, 0) << first.output;  // stopped: 130
+    struct stat st;
+    ASSERT_EQ(stat((dir + "/out.pfm.resume").c_str(), &st), 0) << first.output;
+    CliRun second = rlpbrt::test::runCommand(mpirun(2) + args + " --resume " + dir +
+                                             "/out.pfm.resume -o " + dir + "/out.pfm");
+    ASSERT_EQ(second.status, 0) << second.output;
+    const std::vector<float> a = readPfm(dir + "/whole.pfm"), b = readPfm(dir + "/out.pfm");
+    ASSERT_FALSE(a.empty());
+    EXPECT_TRUE(a == b) << "the resumed job's image differs from the uninterrupted job's";
+}
+
+// A state written by one process, resumed on two ranks: a warning (the guide's sums may be
+// added in another order), and, without a guide, the same image (film tiles are exact).
+TEST(Distributed, ResumeOnAnotherRankCountWarns) {
+    REQUIRE_MPIRUN();
+    const std::string dir = tempDir();
+    const std::string scene = writeRoom(dir + "/room.pbrt", false);
+    const std::string args = scene + " --spp 6 --seed 3 --quiet --nthreads 1 --guide none";
+    CliRun whole = rlpbrt::test::runCli(args + " -o " + dir + "/whole.pfm");
+    ASSERT_EQ(whole.status, 0) << whole.output;
+    CliRun first = rlpbrt::test::runCli(args + " --checkpoint 0 --cancel-at-spp 2 -o " + dir +
+                                        "/out.pfm");
+    ASSERT_EQ(first.status, 130) << first.output;
+    CliRun second = rlpbrt::test::runCommand(mpirun(2) + args + " --resume " + dir +
+                                             "/out.pfm.resume -o " + dir + "/out.pfm");
+    ASSERT_EQ(second.status, 0) << second.output;
+    EXPECT_EQ(count(second.output, "written by 1 rank(s), this run has 2"), 1u)
+        << second.output;
+    const std::vector<float> a = readPfm(dir + "/whole.pfm"), b = readPfm(dir + "/out.pfm");
+    ASSERT_FALSE(a.empty());
+    EXPECT_TRUE(a == b);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, TwoRanksResume,
+                         ::testing::Values(Case{"none", false, "", "none"},
+                                           Case{"hemi", false, "", "hemi"},
+                                           Case{"vdb", true, "", "vdbFog"}),
+                         [](const ::testing::TestParamInfo<Case>& i) {
+                             return std::string(i.param.name);
+                         });
+
 TEST(Distributed, SceneErrorOnceAndNoOutput) {
     REQUIRE_MPIRUN();
     const std::string dir = tempDir();
