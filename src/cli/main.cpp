@@ -521,6 +521,8 @@ int main(int argc, char** argv) {
         // Rank 0's wall seconds in the collectives during the render (waiting for slower
         // ranks included).
         j["exchange_seconds"] = r.secondsExchanging;
+        // ... of which at the barrier before each collective: waiting for the slowest rank.
+        j["exchange_wait_seconds"] = r.secondsWaiting;
         std::ofstream f(statsFile);
         f << j.dump(2) << "\n";
         if (!f) {

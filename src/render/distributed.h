@@ -36,6 +36,9 @@ public:
     // Wall seconds this rank has spent in collectives (transfers, and waiting for slower
     // ranks).
     virtual double secondsExchanging() const = 0;
+    // Of those, the seconds spent waiting for the slowest rank to arrive (a barrier before
+    // each collective), so that the rest is the transfer itself; 0 where not measured.
+    virtual double secondsWaiting() const { return 0.0; }
 };
 
 // Whether tile `index` of a pass is this rank's (null ranks: a single process renders all).

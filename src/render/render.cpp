@@ -163,6 +163,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     const bool everyoneNeedsFilm = field && integrator.wantsPixelEstimate();
     std::vector<float> exchange;
     const double exchangeBefore = ranks ? ranks->secondsExchanging() : 0.0;
+    const double waitingBefore = ranks ? ranks->secondsWaiting() : 0.0;
     if (ranks) {
         size_t n = 0;
         for (const auto& t : tileFilms) n += t->floatCount();
@@ -458,6 +459,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         result.ranks = ranks->size();
         result.bytesExchanged = ranks->bytesExchanged();
         result.secondsExchanging = ranks->secondsExchanging() - exchangeBefore;
+        result.secondsWaiting = ranks->secondsWaiting() - waitingBefore;
     }
     result.image = film.toImage();
     return result;

@@ -67,6 +67,7 @@ struct RenderResult {
     int passes = 0;
     uint64_t bytesExchanged = 0;  // this rank's payload in the ranks' collectives
     double secondsExchanging = 0.0;  // ... and its wall time in them (during the render)
+    double secondsWaiting = 0.0;     // ... of which waiting for the slowest rank
 };
 
 RenderResult render(const Scene& scene, const RenderOptions& options);

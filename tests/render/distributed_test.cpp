@@ -130,6 +130,12 @@ TEST_P(TwoRanks, EqualOneProcess) {
     const std::string stats = slurp(dir + "/two.json");
     EXPECT_NE(stats.find("\"ranks\": 2"), std::string::npos) << stats;
     EXPECT_EQ(stats.find("\"bytes_exchanged\": 0,"), std::string::npos) << stats;
+    // The time in the collectives, and the part of it spent waiting for the other rank.
+    const double exchange = jsonNumber(stats, "\"exchange_seconds\"");
+    const double waiting = jsonNumber(stats, "\"exchange_wait_seconds\"");
+    EXPECT_GT(exchange, 0.0) << stats;
+    EXPECT_GE(waiting, 0.0) << stats;
+    EXPECT_LE(waiting, exchange) << stats;
     // The ranks drew the samples of one process between them, no more (rays and paths are
     // summed over the ranks), and the guide applied as many records.
     const std::string oneStats = slurp(dir + "/one.json");
