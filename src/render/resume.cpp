@@ -42,7 +42,7 @@ bool readArray(guiding::fieldio::Reader& r, const std::string& data, std::vector
     v->resize(size_t(n));
     if (kLittleEndian) {
         const size_t at = data.size() - r.remaining();
-        std::memcpy(v->data(), data.data() + at, size_t(n) * sizeof(T));
+        if (n > 0) std::memcpy(v->data(), data.data() + at, size_t(n) * sizeof(T));
         return r.skip(size_t(n) * sizeof(T));
     }
     for (T& x : *v) {
