@@ -3,7 +3,9 @@
 // seam (sampleDirection / mixturePdf) where a guiding backend plugs in.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <utility>
 #include <memory>
 
 #include "guiding/guiding.h"
@@ -28,15 +30,22 @@ struct PathStats {
     uint64_t guidedVertices = 0;
     uint64_t timedGuidedVertices = 0;
     GuideClockSums guideClock;
+    // Every counter, in one fixed order (sums over threads and ranks, the resume file).
+    static constexpr size_t kCounters = 9;
+    std::array<uint64_t*, kCounters> counters() { return countersOf(*this); }
+    std::array<const uint64_t*, kCounters> counters() const { return countersOf(*this); }
     void add(const PathStats& o) {
-        paths += o.paths;
-        rays += o.rays;
-        vertices += o.vertices;
-        zeroRadiancePaths += o.zeroRadiancePaths;
-        nonFinite += o.nonFinite;
-        guidedVertices += o.guidedVertices;
-        timedGuidedVertices += o.timedGuidedVertices;
-        guideClock.add(o.guideClock);
+        const auto mine = counters();
+        const auto theirs = o.counters();
+        for (size_t i = 0; i < kCounters; ++i) *mine[i] += *theirs[i];
+    }
+
+private:
+    template <class Self>
+    static std::array<decltype(&std::declval<Self&>().paths), kCounters> countersOf(Self& s) {
+        return {&s.paths,          &s.rays,           &s.vertices,
+                &s.zeroRadiancePaths, &s.nonFinite,   &s.guidedVertices,
+                &s.timedGuidedVertices, &s.guideClock.nanos, &s.guideClock.calls};
     }
 };
 

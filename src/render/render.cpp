@@ -224,21 +224,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         PathStats s;
         for (const auto& t : stats) s.add(t);
         if (ranks) {
-            double sums[9] = {double(s.paths),
-                              double(s.rays),
-                              double(s.vertices),
-                              double(s.zeroRadiancePaths),
-                              double(s.nonFinite),
-                              double(s.guidedVertices),
-                              double(s.timedGuidedVertices),
-                              double(s.guideClock.nanos),
-                              double(s.guideClock.calls)};
-            ranks->sumDoubles(sums, 9);
-            s.paths = uint64_t(sums[0]), s.rays = uint64_t(sums[1]);
-            s.vertices = uint64_t(sums[2]);
-            s.zeroRadiancePaths = uint64_t(sums[3]), s.nonFinite = uint64_t(sums[4]);
-            s.guidedVertices = uint64_t(sums[5]), s.timedGuidedVertices = uint64_t(sums[6]);
-            s.guideClock.nanos = uint64_t(sums[7]), s.guideClock.calls = uint64_t(sums[8]);
+            const auto counters = s.counters();
+            double sums[PathStats::kCounters];
+            for (size_t i = 0; i < counters.size(); ++i) sums[i] = double(*counters[i]);
+            ranks->sumDoubles(sums, counters.size());
+            for (size_t i = 0; i < counters.size(); ++i) *counters[i] = uint64_t(sums[i]);
         }
         s.add(earlierStats);
         return s;

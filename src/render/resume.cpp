@@ -77,10 +77,7 @@ bool writeResumeFile(const std::string& path, const ResumeFingerprint& fingerpri
     w.u32(uint32_t(s.spp));
     w.f64(s.seconds);
     w.f64(s.guideEndPassSeconds);
-    w.u64(s.stats.paths), w.u64(s.stats.rays), w.u64(s.stats.vertices);
-    w.u64(s.stats.zeroRadiancePaths), w.u64(s.stats.nonFinite);
-    w.u64(s.stats.guidedVertices), w.u64(s.stats.timedGuidedVertices);
-    w.u64(s.stats.guideClock.nanos), w.u64(s.stats.guideClock.calls);
+    for (const uint64_t* c : s.stats.counters()) w.u64(*c);
     w.u32(uint32_t(s.ranks));
     w.u32((s.guided ? 1u : 0u) | (s.autoRan ? 2u : 0u) | (s.autoKept ? 4u : 0u) |
           (s.frozen ? 8u : 0u));
@@ -140,10 +137,7 @@ bool readResumeFile(const std::string& path, ResumeFingerprint* fingerprint,
     s.spp = int(r.u32());
     s.seconds = r.f64();
     s.guideEndPassSeconds = r.f64();
-    s.stats.paths = r.u64(), s.stats.rays = r.u64(), s.stats.vertices = r.u64();
-    s.stats.zeroRadiancePaths = r.u64(), s.stats.nonFinite = r.u64();
-    s.stats.guidedVertices = r.u64(), s.stats.timedGuidedVertices = r.u64();
-    s.stats.guideClock.nanos = r.u64(), s.stats.guideClock.calls = r.u64();
+    for (uint64_t* c : s.stats.counters()) *c = r.u64();
     s.ranks = int(r.u32());
     const uint32_t flags = r.u32();
     s.guided = flags & 1u, s.autoRan = flags & 2u, s.autoKept = flags & 4u, s.frozen = flags & 8u;
