@@ -66,11 +66,18 @@ struct SelectionSample {
     float scale = 0.f;
 };
 
-// Sums a flat array element-wise over all the processes that learn one field together (the
+// Sums flat arrays element-wise over all the processes that learn one field together (the
 // ranks of a distributed render), leaving the same sums, bit for bit, in every process's
-// array. Every process calls it the same number of times with arrays of the same sizes. The
-// guiding layer knows no more of the processes than this.
-using SumAcrossProcesses = std::function<void(std::vector<double>&)>;
+// array. Every process makes the same calls in the same order with arrays of the same sizes.
+// The guiding layer knows no more of the processes than this.
+struct SumAcrossProcesses {
+    // Doubles, added in a fixed order of the processes.
+    std::function<void(std::vector<double>&)> doubles;
+    // Counts: exact, so the order does not matter; every element's total over the processes
+    // must stay below 2^32 (the caller checks; half the bytes of doubles).
+    std::function<void(std::vector<uint32_t>&)> counts;
+    void operator()(std::vector<double>& v) const { doubles(v); }
+};
 
 class GuidingField;
 class VertexGuide;

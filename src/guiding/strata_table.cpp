@@ -327,8 +327,7 @@ void StrataTable::endPass(bool alphaVisits, double fixedAlpha, const PolicyBuild
 void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
                                 const PolicyBuilder& policy, const SumAcrossProcesses& sum) {
     // 1. Counters, then the records per region (this process's, grouped by region).
-    constexpr size_t kHead = 4;
-    std::vector<double> head(kHead + regions_, 0.0);
+    std::vector<double> head(4, 0.0);
     uint64_t total = 0;
     for (const SlotBuffer& s : slots_) {
         total += s.records.size();
@@ -346,12 +345,22 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
     auto range = [&](size_t r) {
         return std::make_pair(r == 0 ? uint64_t(0) : regionStart_[r - 1], regionStart_[r]);
     };
-    for (size_t r = 0; r < regions_; ++r) {
-        const auto [b, e] = range(r);
-        head[kHead + r] = double(e - b);
-    }
     sum(head);
     const uint64_t allRecords = uint64_t(head[0]);
+    // Counts of 32 bits when the pass's records number fewer than 2^32 (any count below is
+    // at most that), else doubles (exact below 2^53).
+    const bool narrow = head[0] < 4294967296.0;
+    const auto sumCounts = [&](std::vector<uint64_t>& counts) {
+        if (narrow) {
+            std::vector<uint32_t> c(counts.begin(), counts.end());
+            sum.counts(c);
+            std::copy(c.begin(), c.end(), counts.begin());
+        } else {
+            std::vector<double> c(counts.begin(), counts.end());
+            sum(c);
+            for (size_t i = 0; i < c.size(); ++i) counts[i] = uint64_t(c[i]);
+        }
+    };
     ++stats_.passes;
     stats_.records += allRecords;
     stats_.rejectedTargets += uint64_t(head[1]);
@@ -360,26 +369,36 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
     stats_.selectionRegions = selection_.learnedRegions();
     stats_.selectionMean = selection_.meanSelection();
     if (allRecords > 0 && regions_ > 0) {
-        // 2. Per stratum the sum of the targets and their count, for the regions that
-        // received records anywhere (in region order).
+        std::vector<uint64_t> perRegion(regions_);
+        for (size_t r = 0; r < regions_; ++r) {
+            const auto [b, e] = range(r);
+            perRegion[r] = e - b;
+        }
+        sumCounts(perRegion);
+        // 2. For the regions that received records anywhere (in region order): per stratum
+        // the count of records, then the sum of the targets of the strata that received
+        // records anywhere (most strata of a region receive none in a pass).
         std::vector<size_t> touched;
         for (size_t r = 0; r < regions_; ++r)
-            if (head[kHead + r] > 0.0) touched.push_back(r);
+            if (perRegion[r] > 0) touched.push_back(r);
         const size_t n = size_t(strata_);
-        std::vector<double> body(touched.size() * 2 * n, 0.0);
+        std::vector<double> body(touched.size() * n, 0.0);  // sums, dense
+        std::vector<uint64_t> counts(touched.size() * n, 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 256),
                           [&](const tbb::blocked_range<size_t>& rs) {
-                              std::vector<uint64_t> counts(n);
                               for (size_t i = rs.begin(); i != rs.end(); ++i) {
                                   const auto [b, e] = range(touched[i]);
-                                  double* sums = &body[i * 2 * n];
-                                  accumulate(merged_.data() + b, merged_.data() + e, sums,
-                                             counts.data());
-                                  for (size_t j = 0; j < n; ++j)
-                                      sums[n + j] = double(counts[j]);
+                                  accumulate(merged_.data() + b, merged_.data() + e,
+                                             &body[i * n], &counts[i * n]);
                               }
                           });
-        sum(body);
+        sumCounts(counts);
+        std::vector<double> sparse;
+        for (size_t i = 0; i < counts.size(); ++i)
+            if (counts[i] > 0) sparse.push_back(body[i]);
+        sum(sparse);
+        for (size_t i = 0, k = 0; i < counts.size(); ++i)
+            body[i] = counts[i] > 0 ? sparse[k++] : 0.0;
         if (lazy_) {
             std::vector<size_t> fresh;
             for (size_t r : touched)
@@ -388,15 +407,10 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
         }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 256),
                           [&](const tbb::blocked_range<size_t>& rs) {
-                              std::vector<uint64_t> counts(n);
                               std::vector<double> scratch(n + smoothingScratch());
-                              for (size_t i = rs.begin(); i != rs.end(); ++i) {
-                                  const double* sums = &body[i * 2 * n];
-                                  for (size_t j = 0; j < n; ++j)
-                                      counts[j] = uint64_t(sums[n + j]);
-                                  applySums(touched[i], sums, counts.data(), alphaVisits,
-                                            fixedAlpha, scratch.data(), policy);
-                              }
+                              for (size_t i = rs.begin(); i != rs.end(); ++i)
+                                  applySums(touched[i], &body[i * n], &counts[i * n],
+                                            alphaVisits, fixedAlpha, scratch.data(), policy);
                           });
     }
     for (SlotBuffer& s : slots_) {

@@ -110,10 +110,12 @@ public:
     // rebuilds the CDFs of the regions that received records.
     void endPass(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy);
     // endPass for a table that several processes learn together (GuidingField::
-    // endPassShared): the counters and each region's number of records are summed first,
-    // then, for the regions that received records anywhere, each stratum's sum of targets
-    // and count (each process adds its own records in slot order, the processes' sums are
-    // added in rank order), and the selection learner's statistics. The update is endPass's.
+    // endPassShared): the counters, the selection learner's statistics and each region's
+    // number of records are summed first; then, for the regions that received records
+    // anywhere, each stratum's count, and the sums of the targets of the strata that received
+    // records anywhere (each process adds its own records in slot order, the processes' sums
+    // are added in rank order). Counts go as 32-bit integers while the pass has fewer than
+    // 2^32 records. The update is endPass's.
     void endPassShared(bool alphaVisits, double fixedAlpha, const PolicyBuilder& policy,
                        const SumAcrossProcesses& sum);
 

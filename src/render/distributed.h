@@ -20,6 +20,9 @@ public:
     // Element-wise sum over all ranks into every rank's `data`: the same bits on every rank,
     // whatever order the ranks arrive in (the terms are added in rank order).
     virtual void sumDoubles(double* data, size_t n) = 0;
+    // Element-wise sum of counts over all ranks into every rank's `data` (exact in any order;
+    // each total must be below 2^32).
+    virtual void sumCounts(uint32_t* data, size_t n) = 0;
     // Element-wise sum of float buffers in which every element is non-zero on at most one
     // rank (film tiles that one rank rendered): the sum is exact, so any order gives the
     // owner's bits. everyone: the result on every rank, else on rank 0 only (the others'

@@ -24,10 +24,11 @@ namespace {
 
 // SumAcrossProcesses for K threads: each passes its array, the last to arrive adds them in
 // rank order and gives every thread the result.
+template <typename T>
 class ThreadSum {
 public:
     explicit ThreadSum(int k) : k_(k), arrays_(size_t(k), nullptr) {}
-    void sum(int rank, std::vector<double>& v) {
+    void sum(int rank, std::vector<T>& v) {
         std::unique_lock<std::mutex> lock(mutex_);
         arrays_[size_t(rank)] = &v;
         const long generation = generation_;
@@ -35,12 +36,12 @@ public:
             cv_.wait(lock, [&] { return generation_ != generation; });
             return;
         }
-        std::vector<double> total(v.size(), 0.0);
-        for (std::vector<double>* a : arrays_) {
+        std::vector<T> total(v.size(), T(0));
+        for (std::vector<T>* a : arrays_) {
             EXPECT_EQ(a->size(), total.size()) << "every rank passes arrays of the same size";
             for (size_t i = 0; i < std::min(a->size(), total.size()); ++i) total[i] += (*a)[i];
         }
-        for (std::vector<double>* a : arrays_) *a = total;
+        for (std::vector<T>* a : arrays_) *a = total;
         ++calls_;
         arrived_ = 0;
         ++generation_;
@@ -51,7 +52,7 @@ public:
 private:
     int k_, arrived_ = 0, calls_ = 0;
     long generation_ = 0;
-    std::vector<std::vector<double>*> arrays_;
+    std::vector<std::vector<T>*> arrays_;
     std::mutex mutex_;
     std::condition_variable cv_;
 };
@@ -135,7 +136,8 @@ void checkShared(const char* backend, const SceneInfo& scene,
     for (int k = 0; k < kRanks; ++k)
         ranks.push_back(test::makeField<Field>(backend, scene, params));
     ASSERT_TRUE(one);
-    ThreadSum sum(kRanks);
+    ThreadSum<double> sum(kRanks);
+    ThreadSum<uint32_t> counts(kRanks);
     for (int pass = 0; pass < kPasses; ++pass) {
         one->beginPass(kSlots);
         for (int s = 0; s < kSlots; ++s) recordSlot(*one, pass, s);
@@ -146,7 +148,9 @@ void checkShared(const char* backend, const SceneInfo& scene,
                 Field& f = *ranks[size_t(k)];
                 f.beginPass(kSlots);
                 for (int s = k; s < kSlots; s += kRanks) recordSlot(f, pass, s);
-                f.endPassShared([&](std::vector<double>& v) { sum.sum(k, v); });
+                f.endPassShared(
+                    {[&](std::vector<double>& v) { sum.sum(k, v); },
+                     [&](std::vector<uint32_t>& v) { counts.sum(k, v); }});
             });
         for (std::thread& t : threads) t.join();
     }
@@ -154,6 +158,7 @@ void checkShared(const char* backend, const SceneInfo& scene,
     EXPECT_GT(one->stats().rejectedTargets, 0u);
     EXPECT_GT(one->stats().selectionRegions, 0u);
     EXPECT_GE(sum.calls(), 2 * kPasses);
+    EXPECT_GE(counts.calls(), 2 * kPasses);
     for (int k = 0; k < kRanks; ++k) {
         SCOPED_TRACE(k);
         expectSameField(*one, *ranks[size_t(k)], regions(*one));
