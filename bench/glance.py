@@ -2,6 +2,7 @@
 """The tables and plots of docs/BENCHMARKS.md's "results at a glance", from stored runs.
 
     bench/glance.py [--plots]
+    bench/glance.py --study120      (the 120-s study's table, issue 30)
 
 Reads the bench/curves.sh runs named below (each run twice, A and B with the configurations'
 core order reversed), prints per scene and backend the relMSE ratio to plain path tracing at
@@ -124,7 +125,51 @@ def plots(data):
     fig.savefig(os.path.join(img, "equal-time.png"), dpi=72)
 
 
+# The 120-s study (issue 30): hemi against none for 120 s of a core each, runs A and B.
+STUDY_120 = ("study-120-2026-12-04-s22-A", "study-120-2026-12-04-s22-B")
+SHARED = os.environ.get("RLPBRT_SHARED", os.path.join(HERE, "..", "..", "shared"))
+
+
+def reference_error():
+    """{scene: rough relMSE of pbrt-v3's reference itself}: pbrt-v3's own 64-spp error scaled
+    by 64 / the reference's spp (1/N convergence; Sobol sampling converges faster on smooth
+    pixels, so this overestimates where the light is simple)."""
+    import csv
+    out = {}
+    with open(os.path.join(SHARED, "references", "manifest.tsv")) as f:
+        for row in csv.DictReader(f, delimiter="\t"):
+            out[row["id"].split("__")[0]] = (float(row["pbrt_64spp_relmse_trim"]) * 64 /
+                                             float(row["ref_spp"]))
+    return out
+
+
+def study120():
+    """Prints the 120-s study's table beside the 30-s ratios (RUNS["hemi"])."""
+    long = [summary(r, "hemi") for r in STUDY_120]
+    short = [summary(r, "hemi") for r in RUNS["hemi"]]
+    plain = [{s: v for s, v in cr.load_runs(os.path.join(RESULTS, r)).items()}
+             for r in STUDY_120]
+    ref = reference_error()
+    print("| scene | hemi / none at 30 s | hemi / none at 120 s | none relMSE at 120 s | "
+          "reference's own error (rough) |")
+    print("|---|---:|---:|---:|---:|")
+    for scene in sorted(long[0]):
+        p = []
+        for run in plain:
+            for key, configs in run.items():
+                if key.split("__")[0] == scene:
+                    p.append(configs["none"][0][-1][2])
+        cell = lambda d: " / ".join("{:.2f}".format(x[scene]["ratio"]) if scene in x else "-"
+                                    for x in d)
+        print("| {} | {} | {} | {} | {:.2g} |".format(
+            scene, cell(short), cell(long), " / ".join("{:.3g}".format(v) for v in p),
+            ref.get(scene, float("nan"))))
+
+
 if __name__ == "__main__":
+    if "--study120" in sys.argv:
+        study120()
+        sys.exit()
     d = table()
     if "--plots" in sys.argv:
         plots(d)
