@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <thread>
 #include <unistd.h>
 #include <cstdlib>
 
@@ -486,8 +485,8 @@ int main(int argc, char** argv) {
             const double nsPerVertex =
                 s.timedGuidedVertices ? s.guideClock.guideNanos() / double(s.timedGuidedVertices)
                                       : 0.0;
-            const int threads =
-                nThreads > 0 ? nThreads : int(std::max(1u, std::thread::hardware_concurrency()));
+            // Vertices of all ranks over the thread time of all ranks.
+            const double threads = double(r.threads) * double(r.ranks);
             j["guide_guided_vertices"] = s.guidedVertices;
             j["guide_ns_per_guided_vertex"] = nsPerVertex;
             j["guide_end_pass_seconds"] = r.guideEndPassSeconds;

@@ -108,6 +108,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     std::vector<Bounds2i> tiles = film.sampleTiles(16);
     int nThreads = options.nThreads > 0 ? options.nThreads
                                         : int(std::max(1u, std::thread::hardware_concurrency()));
+    result.threads = nThreads;
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(nThreads));
     tbb::task_arena arena(nThreads);
 

@@ -63,6 +63,7 @@ struct RenderResult {
         int guidedSpp = 0;
         double guidedCost = 0.0, plainCost = 0.0;
     } autoTrial;
+    int threads = 1;              // threads per process (RenderOptions::nThreads resolved)
     int ranks = 1;                // processes that rendered (RenderOptions::ranks)
     int passes = 0;
     uint64_t bytesExchanged = 0;  // this rank's payload in the ranks' collectives

@@ -102,7 +102,9 @@ CaseRun renderCase(const Case& c, int nThreads, int stopAt, const RenderSnapshot
     EXPECT_TRUE(setupGuiding(*scene, gc, &field, &ro.guide, &err)) << err;
     ro.nThreads = nThreads;
     if (resume) {
-        if (field) EXPECT_TRUE(field->loadState(resume->guide, &err)) << err;
+        if (field) {
+            EXPECT_TRUE(field->loadState(resume->guide, &err)) << err;
+        }
         ro.resume = resume;
     }
     std::atomic<bool> cancel{false};
@@ -136,11 +138,21 @@ TEST_P(Resume, EqualsUninterrupted) {
     EXPECT_EQ(first.snapshot.spp, first.result.spp);
     // The state the case is about is there to be restored.
     const std::string params = c.params;
-    if (params.rfind("mix=learn", 0) == 0) EXPECT_GT(first.guideStats.selectionRegions, 0u);
-    if (params == "rr=adjoint") EXPECT_FALSE(first.snapshot.estimates.empty());
-    if (params == "learn=4") EXPECT_TRUE(first.snapshot.frozen);
-    if (params == "auto=4") EXPECT_EQ(first.snapshot.trial, c.stopAt == 2 ? 1 : 2);
-    if (c.fog && std::string(c.guide) == "vdb") EXPECT_GT(first.guideStats.mediumCells, 0u);
+    if (params.rfind("mix=learn", 0) == 0) {
+        EXPECT_GT(first.guideStats.selectionRegions, 0u);
+    }
+    if (params == "rr=adjoint") {
+        EXPECT_FALSE(first.snapshot.estimates.empty());
+    }
+    if (params == "learn=4") {
+        EXPECT_TRUE(first.snapshot.frozen);
+    }
+    if (params == "auto=4") {
+        EXPECT_EQ(first.snapshot.trial, c.stopAt == 2 ? 1 : 2);
+    }
+    if (c.fog && std::string(c.guide) == "vdb") {
+        EXPECT_GT(first.guideStats.mediumCells, 0u);
+    }
     // Through the file, and on another thread count.
     const std::string path = tempDir() + "/state.resume";
     const ResumeFingerprint fp = {{"spp", "16"}, {"--guide", c.guide}};
