@@ -74,8 +74,10 @@ struct SumAcrossProcesses {
     // Doubles, added in a fixed order of the processes.
     std::function<void(std::vector<double>&)> doubles;
     // Counts: exact, so the order does not matter; every element's total over the processes
-    // must stay below 2^32 (the caller checks; half the bytes of doubles).
+    // must stay below countLimit (the caller checks, and sends larger counts as doubles;
+    // half the bytes of doubles).
     std::function<void(std::vector<uint32_t>&)> counts;
+    double countLimit = 4294967296.0;  // 2^32
     void operator()(std::vector<double>& v) const { doubles(v); }
 };
 

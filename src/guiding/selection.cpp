@@ -146,7 +146,7 @@ void SelectionLearner::endPassShared(const SumAcrossProcesses& sum, uint64_t tot
         slots_, [](const SlotBuffer& s) -> const std::vector<Sample>& { return s.samples; },
         regions, &start_, &merged_);
     std::vector<double> counts(regions, 0.0);
-    if (total > 0 && total < 4294967296u) {  // counts of 32 bits: half the bytes
+    if (total > 0 && double(total) < sum.countLimit) {  // counts of 32 bits: half the bytes
         std::vector<uint32_t> c(regions);
         for (size_t r = 0; r < regions; ++r)
             c[r] = uint32_t(start_[r] - (r == 0 ? 0 : start_[r - 1]));

@@ -349,7 +349,7 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
     const uint64_t allRecords = uint64_t(head[0]);
     // Counts of 32 bits when the pass's records number fewer than 2^32 (any count below is
     // at most that), else doubles (exact below 2^53).
-    const bool narrow = head[0] < 4294967296.0;
+    const bool narrow = head[0] < sum.countLimit;
     const auto sumCounts = [&](std::vector<uint64_t>& counts) {
         if (narrow) {
             std::vector<uint32_t> c(counts.begin(), counts.end());
