@@ -45,6 +45,14 @@ struct Timed {
 // Counts above INT_MAX go in chunks.
 constexpr size_t kChunk = size_t(1) << 28;
 
+// MPI_Allreduce in place of n elements of `type` (`size` bytes each), chunk by chunk.
+void allreduceInPlace(void* data, size_t n, MPI_Datatype type, size_t size, MPI_Op op) {
+    char* p = static_cast<char*>(data);
+    for (size_t off = 0; off < n; off += kChunk)
+        MPI_Allreduce(MPI_IN_PLACE, p + off * size, int(std::min(kChunk, n - off)), type, op,
+                      MPI_COMM_WORLD);
+}
+
 class MpiRanks final : public Ranks {
 public:
     MpiRanks() {
@@ -63,9 +71,7 @@ public:
         if (size_ == 2) {
             // Two terms: a + b and b + a are the same bits, so one allreduce gives every rank
             // the rank-order sum.
-            for (size_t off = 0; off < n; off += kChunk)
-                MPI_Allreduce(MPI_IN_PLACE, data + off, int(std::min(kChunk, n - off)),
-                              MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+            allreduceInPlace(data, n, MPI_DOUBLE, sizeof(double), MPI_SUM);
             return;
         }
         std::vector<double> out(rank_ == 0 ? std::min(n, kChunk) : 0);
@@ -83,24 +89,20 @@ public:
         Timed t(&seconds_);
         arrive();
         bytes_ += n * sizeof(uint32_t);
-        for (size_t off = 0; off < n; off += kChunk)
-            MPI_Allreduce(MPI_IN_PLACE, data + off, int(std::min(kChunk, n - off)), MPI_UINT32_T,
-                          MPI_SUM, MPI_COMM_WORLD);
+        allreduceInPlace(data, n, MPI_UINT32_T, sizeof(uint32_t), MPI_SUM);
     }
 
     void sumDisjointFloats(float* data, size_t n, bool everyone) override {
         Timed t(&seconds_);
         arrive();
         bytes_ += n * sizeof(float);
-        for (size_t off = 0; off < n; off += kChunk) {
-            const int c = int(std::min(kChunk, n - off));
-            if (everyone)
-                MPI_Allreduce(MPI_IN_PLACE, data + off, c, MPI_FLOAT, MPI_SUM, MPI_COMM_WORLD);
-            else
-                MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : data + off,
-                           rank_ == 0 ? data + off : nullptr, c, MPI_FLOAT, MPI_SUM, 0,
-                           MPI_COMM_WORLD);
+        if (everyone) {
+            allreduceInPlace(data, n, MPI_FLOAT, sizeof(float), MPI_SUM);
+            return;
         }
+        for (size_t off = 0; off < n; off += kChunk)
+            MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : data + off, rank_ == 0 ? data + off : nullptr,
+                       int(std::min(kChunk, n - off)), MPI_FLOAT, MPI_SUM, 0, MPI_COMM_WORLD);
     }
 
     void broadcast(void* data, size_t bytes) override {

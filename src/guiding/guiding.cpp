@@ -1,5 +1,6 @@
 #include "guiding/guiding.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
@@ -31,6 +32,18 @@ float GuidingField::patchSize() const { return 0.f; }
 void GuidingField::setPatches(uint32_t, std::function<bool(uint32_t, glm::vec3*, glm::vec3*)>) {}
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
+
+void SumAcrossProcesses::sumCounts(std::vector<uint64_t>& v, double bound) const {
+    if (bound < countLimit) {
+        std::vector<uint32_t> c(v.begin(), v.end());
+        counts(c);
+        std::copy(c.begin(), c.end(), v.begin());
+    } else {
+        std::vector<double> c(v.begin(), v.end());
+        doubles(c);
+        for (size_t i = 0; i < c.size(); ++i) v[i] = uint64_t(c[i]);
+    }
+}
 
 void GuidingField::endPassShared(const SumAcrossProcesses&) { endPass(); }
 

@@ -79,6 +79,9 @@ struct SumAcrossProcesses {
     std::function<void(std::vector<uint32_t>&)> counts;
     double countLimit = 4294967296.0;  // 2^32
     void operator()(std::vector<double>& v) const { doubles(v); }
+    // Sums counts whose totals over the processes are at most `bound`: through `counts` when
+    // bound < countLimit, else as doubles (exact below 2^53).
+    void sumCounts(std::vector<uint64_t>& v, double bound) const;
 };
 
 class GuidingField;

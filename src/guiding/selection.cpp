@@ -145,18 +145,10 @@ void SelectionLearner::endPassShared(const SumAcrossProcesses& sum, uint64_t tot
     mergeByRegion<Sample>(
         slots_, [](const SlotBuffer& s) -> const std::vector<Sample>& { return s.samples; },
         regions, &start_, &merged_);
-    std::vector<double> counts(regions, 0.0);
-    if (total > 0 && double(total) < sum.countLimit) {  // counts of 32 bits: half the bytes
-        std::vector<uint32_t> c(regions);
-        for (size_t r = 0; r < regions; ++r)
-            c[r] = uint32_t(start_[r] - (r == 0 ? 0 : start_[r - 1]));
-        sum.counts(c);
-        for (size_t r = 0; r < regions; ++r) counts[r] = double(c[r]);
-    } else if (total > 0) {
-        for (size_t r = 0; r < regions; ++r)
-            counts[r] = double(start_[r] - (r == 0 ? 0 : start_[r - 1]));
-        sum(counts);
-    }
+    std::vector<uint64_t> perRegion(regions);
+    for (size_t r = 0; r < regions; ++r) perRegion[r] = start_[r] - (r == 0 ? 0 : start_[r - 1]);
+    if (total > 0) sum.sumCounts(perRegion, double(total));
+    const std::vector<double> counts(perRegion.begin(), perRegion.end());
     std::vector<size_t> touched;
     for (size_t r = 0; r < regions; ++r)
         if (counts[r] > 0.0) touched.push_back(r);

@@ -347,20 +347,6 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
     };
     sum(head);
     const uint64_t allRecords = uint64_t(head[0]);
-    // Counts of 32 bits when the pass's records number fewer than 2^32 (any count below is
-    // at most that), else doubles (exact below 2^53).
-    const bool narrow = head[0] < sum.countLimit;
-    const auto sumCounts = [&](std::vector<uint64_t>& counts) {
-        if (narrow) {
-            std::vector<uint32_t> c(counts.begin(), counts.end());
-            sum.counts(c);
-            std::copy(c.begin(), c.end(), counts.begin());
-        } else {
-            std::vector<double> c(counts.begin(), counts.end());
-            sum(c);
-            for (size_t i = 0; i < c.size(); ++i) counts[i] = uint64_t(c[i]);
-        }
-    };
     ++stats_.passes;
     stats_.records += allRecords;
     stats_.rejectedTargets += uint64_t(head[1]);
@@ -374,7 +360,7 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
             const auto [b, e] = range(r);
             perRegion[r] = e - b;
         }
-        sumCounts(perRegion);
+        sum.sumCounts(perRegion, head[0]);  // no count exceeds the pass's records
         // 2. For the regions that received records anywhere (in region order): per stratum
         // the count of records, then the sum of the targets of the strata that received
         // records anywhere (most strata of a region receive none in a pass).
@@ -392,7 +378,7 @@ void StrataTable::endPassShared(bool alphaVisits, double fixedAlpha,
                                              &body[i * n], &counts[i * n]);
                               }
                           });
-        sumCounts(counts);
+        sum.sumCounts(counts, head[0]);
         std::vector<double> sparse;
         for (size_t i = 0; i < counts.size(); ++i)
             if (counts[i] > 0) sparse.push_back(body[i]);
