@@ -33,6 +33,17 @@ void GuidingField::setPatches(uint32_t, std::function<bool(uint32_t, glm::vec3*,
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
 
+glm::vec3 GuidingField::sampleAt(int region, const glm::vec3&, glm::vec2 u, float uStratum,
+                                 float* pdf, int* bin) const {
+    return sample(region, u, uStratum, pdf, bin);
+}
+float GuidingField::pdfAt(int region, const glm::vec3&, const glm::vec3& w, int* bin) const {
+    return pdf(region, w, bin);
+}
+void GuidingField::recordSpot(int, int, const glm::vec3&, const glm::vec3&, const glm::vec3&,
+                              float, int) {}
+bool GuidingField::learnsSpots() const { return false; }
+
 void SumAcrossProcesses::sumCounts(std::vector<uint64_t>& v, double bound) const {
     if (bound < countLimit) {
         std::vector<uint32_t> c(v.begin(), v.end());
@@ -224,6 +235,19 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (!parseUnsigned(value, uint64_t(DirTree::kMaxDepth), &u) || u < 1)
                 return badValue("hemi", key, value, error);
             hp->treeDepth = int(u);
+        } else if (key == "spots") {
+            if (!parseUnsigned(value, 16, &u)) return badValue("hemi", key, value, error);
+            hp->spots = int(u);
+        } else if (key == "spot-share") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || !(d > 0.0) || d > 1.0)
+                return badValue("hemi", key, value, error);
+            hp->spotShare = d;
+        } else if (key == "spot-outlier") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || !(d >= 1.0) || d > 1e9)
+                return badValue("hemi", key, value, error);
+            hp->spotOutlier = d;
         } else {
             return unknownParam("hemi", key, error);
         }

@@ -161,6 +161,13 @@ public:
     // in the region (its stratum; -1 outside): a token that record() and radiance() accept
     // for the same region and w instead of finding the bin again.
     virtual float pdf(int region, const glm::vec3& w, int* bin = nullptr) const = 0;
+    // sample() and pdf() for a vertex at x in the region: a backend whose distribution
+    // depends on the vertex's position (hemi's spot lobes aim at points) answers here; the
+    // defaults are sample() and pdf(). VertexGuide calls these.
+    virtual glm::vec3 sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uStratum,
+                               float* pdf, int* bin = nullptr) const;
+    virtual float pdfAt(int region, const glm::vec3& x, const glm::vec3& w,
+                        int* bin = nullptr) const;
     // The bootstrap part of Eq. 1 at a region y: (2pi/n) * sum_j Q(y,j) * fcos(w_j), where
     // fcos(world dir) returns f_s(w_j, y, -w) * max(0, cos) as a scalar (luminance). w_j are
     // the unit world directions of the stratum centres. Non-finite or negative fcos values
@@ -206,6 +213,15 @@ public:
     // bin from pdf()/sample() for this region, or -1 (found from w).
     virtual void record(int slot, int region, const glm::vec3& w, float target,
                         int bin = -1) = 0;
+    // Records that direction w, sampled at the vertex x of `region`, reached the next vertex
+    // at `hit`, where it found `light` (luminance: the emission and next-event estimation
+    // there, as the estimator weighted them). For backends that learn small bright sources
+    // (hemi's spots); thread-safe across slots like record(). Default: ignored.
+    virtual void recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
+                            const glm::vec3& hit, float light, int bin = -1);
+    // Whether recordSpot is used (the integrator then reports the next vertices). Default:
+    // false.
+    virtual bool learnsSpots() const;
     // Asks the field to model the medium around p (a medium vertex where locate found no
     // data) from the next pass on. Thread-safe across slots, like record(). Default: ignored.
     virtual void requestMedium(int slot, const glm::vec3& p);
@@ -264,18 +280,21 @@ public:
 class VertexGuide {
 public:
     VertexGuide() = default;
-    VertexGuide(const GuidingField* field, int region) : field_(field), region_(region) {}
+    VertexGuide(const GuidingField* field, int region, const glm::vec3& p = glm::vec3(0.f))
+        : field_(field), region_(region), p_(p) {}
     bool valid() const { return region_ >= 0; }
     int region() const { return region_; }
+    // The vertex's position (the query's p).
+    const glm::vec3& position() const { return p_; }
     // How far the region's policy is trusted, in [0, 1].
     float confidence() const { return field_->confidence(region_); }
     // The learned probability of choosing the guide, or -1 where none is learned.
     float selection() const { return field_->selection(region_); }
     glm::vec3 sample(glm::vec2 u, float uStratum, float* pdf, int* bin = nullptr) const {
-        return field_->sample(region_, u, uStratum, pdf, bin);
+        return field_->sampleAt(region_, p_, u, uStratum, pdf, bin);
     }
     float pdf(const glm::vec3& w, int* bin = nullptr) const {
-        return field_->pdf(region_, w, bin);
+        return field_->pdfAt(region_, p_, w, bin);
     }
     float radiance(const glm::vec3& w, int bin = -1) const {
         return field_->radiance(region_, w, bin);
@@ -293,6 +312,7 @@ public:
 private:
     const GuidingField* field_ = nullptr;
     int region_ = -1;
+    glm::vec3 p_{0.f};
 };
 
 // One work item's (film tile's) training slot of a field during a pass: records go to the
@@ -305,6 +325,12 @@ public:
     void record(const VertexGuide& guide, const glm::vec3& w, float target, int bin = -1) {
         field_->record(slot_, guide.region(), w, target, bin);
     }
+    // Direction w of the vertex of `guide` reached `hit`, which gave `light`
+    // (GuidingField::recordSpot).
+    void recordSpot(const VertexGuide& guide, const glm::vec3& w, const glm::vec3& hit,
+                    float light, int bin = -1) {
+        field_->recordSpot(slot_, guide.region(), guide.position(), w, hit, light, bin);
+    }
     void recordSelection(const VertexGuide& guide, const SelectionSample& s) {
         field_->recordSelection(slot_, guide.region(), s);
     }
@@ -316,7 +342,7 @@ private:
 };
 
 inline VertexGuide GuidingField::guide(const VertexQuery& q) const {
-    return VertexGuide(this, locate(q));
+    return VertexGuide(this, locate(q), q.p);
 }
 inline TrainingSlot GuidingField::slot(int index) { return TrainingSlot(this, index); }
 

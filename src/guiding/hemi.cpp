@@ -99,6 +99,14 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         trees_ = std::make_unique<TreeTable>();
         trees_->reset(regions, ts);
     }
+    if (params.spots > 0) {
+        SpotSettings ss;
+        ss.perRegion = params.spots;
+        ss.maxShare = params.spotShare;
+        ss.outlier = params.spotOutlier;
+        spots_ = std::make_unique<SpotLobes>();
+        spots_->reset(regions, ss);
+    }
     // (reset built region 0 and copied it to the others)
     if (regions > 0) {
         std::vector<double> est(static_cast<size_t>(strata_));
@@ -203,6 +211,7 @@ int HemiField::prefetched(int region) const {
     // other work, e.g. a shadow ray, before its first query). Measured on cornell-box, 16 spp:
     // -17% profile samples of a guided render.
     prefetchLine(&frames_[size_t(region)]);
+    if (spots_) spots_->prefetch(region);
     prefetchLines(cdf(region), size_t(strata_ + 1) * sizeof(float));
     // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
     // targets): a read without the prefetch waits (cornell-box, 64 spp, perf: radiance() 705
@@ -273,6 +282,55 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfO
     if (!(p > 0.f)) p = density;
     *pdfOut = p;
     return w;
+}
+
+float HemiField::pdfAt(int region, const glm::vec3& x, const glm::vec3& w, int* bin) const {
+    const float p = pdf(region, w, bin);
+    const float s = spots_ ? spots_->share(region) : 0.f;
+    if (!(s > 0.f)) return p;
+    glm::vec3 unit;
+    if (!unitDirection(w, &unit)) return (1.f - s) * p;
+    return (1.f - s) * p + s * spots_->pdf(region, x, unit);
+}
+
+glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uStratum,
+                              float* pdfOut, int* bin) const {
+    const float s = spots_ ? spots_->share(region) : 0.f;
+    if (!(s > 0.f)) return sample(region, u, uStratum, pdfOut, bin);
+    // One-sample mixture: the lobes with probability s, else the strata; the density is the
+    // mixture's.
+    glm::vec3 w;
+    if (uStratum < s) {
+        w = spots_->sample(region, x, u, std::min(uStratum / s, 0.99999994f));
+        if (!(glm::dot(w, w) > 0.f)) {
+            *pdfOut = 0.f;
+            if (bin) *bin = -1;
+            return glm::vec3(0.f);
+        }
+        *pdfOut = pdfAt(region, x, w, bin);
+        // Marked as the lobes' sample: record() keeps it out of the strata's means (a lobe
+        // aims most of its samples at the bright spot inside its stratum, so their mean
+        // would overstate the stratum's light many times over).
+        if (bin && *bin >= 0) *bin |= kSpotBin;
+        return w;
+    }
+    float ps = 0.f;
+    w = sample(region, u, std::min((uStratum - s) / (1.f - s), 0.99999994f), &ps, bin);
+    *pdfOut = (1.f - s) * ps + s * spots_->pdf(region, x, w);
+    return w;
+}
+
+void HemiField::recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
+                           const glm::vec3& hit, float light, int bin) {
+    if (!spots_ || !validRegion(region) || trees_) return;
+    // Only where the strata have learned enough to tell a spot from their estimate.
+    if (frames_[size_t(region)].confidence < 0.5f) return;
+    const int j = stratumOf(region, w, bin >= 0 ? bin & ~kSpotBin : bin);
+    if (j < 0) return;
+    glm::vec3 unit;
+    if (!unitDirection(w, &unit)) return;
+    // The policy's Q (from the CDF, which the vertex's sampling has just read).
+    spots_->record(slot, region, x, unit, hit, light, policyRadiance(region, unit, j));
 }
 
 float HemiField::scatteredEstimate(int region,
@@ -347,6 +405,7 @@ float HemiField::policyRadiance(int region, const glm::vec3& w, int bin) const {
 
 void HemiField::beginPass(int numSlots) {
     table_.beginPass(numSlots);
+    if (spots_) spots_->beginPass(numSlots);
     if (trees_) trees_->beginPass(numSlots);
 }
 
@@ -357,6 +416,7 @@ void HemiField::record(int slot, int region, const glm::vec3& w, float target, i
         trees_->record(slot, validRegion(region) ? uint32_t(region) : UINT32_MAX, a, target);
         return;
     }
+    if (bin >= 0 && (bin & kSpotBin)) return;  // sampled by a spot lobe (sampleAt)
     table_.record(slot, region, target, [&] { return stratumOf(region, w, bin); });
 }
 
@@ -400,6 +460,15 @@ void HemiField::buildPolicy(const double* q, float* cdf) const {
 
 void HemiField::endPass() {
     table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
+    if (spots_) {
+        spots_->endPass([this](size_t r) {
+            const double* q = table_.q(r);
+            const uint64_t* v = table_.visits(r);
+            double total = 0.0;
+            for (int j = 0; j < strata_; ++j) total += q[j] * double(v[j]);
+            return total;
+        });
+    }
     if (trees_) {
         trees_->endPass();
         updateTreeRegions();
@@ -431,7 +500,7 @@ void HemiField::endPassShared(const SumAcrossProcesses& sum) {
 }
 
 size_t HemiField::bytes() const {
-    return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
+    return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (spots_ ? spots_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
            frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +
            (cache_ ? cache_->bytes() : 0) + size_t(numPatches_) * sizeof(uint32_t);
 }
@@ -475,6 +544,12 @@ std::string HemiField::describe() const {
                       double(trees_->bytes()) / (1024.0 * 1024.0));
         line += buf;
     }
+    if (spots_) {
+        std::snprintf(buf, sizeof(buf), "; spots=%d (share %g, outlier %g): %zu lobes in %zu hemispheres",
+                      params_.spots, params_.spotShare, params_.spotOutlier,
+                      spots_->activeLobes(), spots_->activeRegions());
+        line += buf;
+    }
     if (numPatches_ > 0) {
         std::snprintf(buf, sizeof(buf), "; %u surface patches", numPatches_);
         line += buf;
@@ -497,6 +572,10 @@ GuidingStats HemiField::stats() const {
 bool HemiField::save(const std::string& path, std::string* error) const {
     if (trees_) {
         *error = "hemi with directions=tree cannot be saved yet";
+        return false;
+    }
+    if (spots_) {
+        *error = "hemi with spots cannot be saved yet";
         return false;
     }
     return fieldio::writeFile(path, serialize(), error);
@@ -602,6 +681,10 @@ bool HemiField::saveState(std::string* state, std::string* error) const {
         *error = "hemi with directions=tree cannot save its learning state yet";
         return false;
     }
+    if (spots_) {
+        *error = "hemi with spots cannot save its learning state yet";
+        return false;
+    }
     fieldio::Writer w;
     w.blob(serialize());
     table_.selection().saveState(w);
@@ -612,6 +695,10 @@ bool HemiField::saveState(std::string* state, std::string* error) const {
 bool HemiField::loadState(const std::string& state, std::string* error) {
     if (trees_) {
         *error = "hemi with directions=tree cannot restore a learning state yet";
+        return false;
+    }
+    if (spots_) {
+        *error = "hemi with spots cannot restore a learning state yet";
         return false;
     }
     fieldio::Reader r(state);

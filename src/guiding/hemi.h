@@ -18,6 +18,7 @@
 #include "guiding/directional.h"
 #include "guiding/guiding.h"
 #include "guiding/kdtree.h"
+#include "guiding/spots.h"
 #include "guiding/strata_table.h"
 #include "guiding/tree_table.h"
 
@@ -77,6 +78,9 @@ struct HemiParams {
     bool treeDirections = false;
     double treeSplit = 0.03;
     int treeDepth = 12;
+    int spots = 0;            // spot lobes per region (0: off)
+    double spotShare = 0.5;
+    double spotOutlier = 10.0;
 };
 
 // Estimated bytes of a hemi field with these parameters (tables, CDFs, points, kd-tree).
@@ -113,6 +117,14 @@ public:
     glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
                      int* bin = nullptr) const override;
     float pdf(int region, const glm::vec3& w, int* bin = nullptr) const override;
+    glm::vec3 sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uStratum,
+                       float* pdf, int* bin = nullptr) const override;
+    float pdfAt(int region, const glm::vec3& x, const glm::vec3& w,
+                int* bin = nullptr) const override;
+    void recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
+                    const glm::vec3& hit, float light, int bin = -1) override;
+    bool learnsSpots() const override { return spots_ != nullptr; }
+    const SpotLobes* spots() const { return spots_.get(); }
     float scatteredEstimate(int region,
                             const std::function<float(const glm::vec3&)>& fcos) const override;
     float irradianceEstimate(int region, const glm::vec3& n) const override;
@@ -131,7 +143,7 @@ public:
     void endPass() override;
     void endPassShared(const SumAcrossProcesses& sum) override;
     // Not with directions=tree: its adaptive trees are not shared yet.
-    bool sharesPasses() const override { return !trees_; }
+    bool sharesPasses() const override { return !trees_ && !spots_; }
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;
@@ -220,6 +232,10 @@ private:
         };
     }
 
+    // A bin flag: the direction was drawn from the spot lobes (sampleAt); bins with it are
+    // out of the strata's range, so radiance() and policyRadiance() find the stratum again.
+    static constexpr int kSpotBin = 1 << 24;
+
     HemiParams params_;
     StrataLayout layout_;
     glm::vec3 sceneMin_, sceneMax_;  // the scene fingerprint of saved fields
@@ -231,6 +247,7 @@ private:
     int numRegions_ = 0;                // 2 x the points (validRegion on every query)
     std::unique_ptr<PointKdTree> tree_;
     std::unique_ptr<CellCache> cache_;  // lookup=cell only
+    std::unique_ptr<SpotLobes> spots_;  // spots > 0 only
     // lookup=patch: per patch 0 (not yet filled), point + 1, or kNoPoint (no admissible
     // point), read and written with relaxed atomics (a fill is a pure function of the patch,
     // so racing fills agree); zeroed pages from calloc, so a large table of patches that no

@@ -23,6 +23,11 @@ const std::vector<GuideOption>& guideOptions() {
          "pixel's estimate (adjoint), or pbrt-v3's on the throughput"},
         {"rr-window", O::kBoth, kIntegrator, "0.1", "a number in (0, 1]",
          "the adjoint roulette's window: paths below this share of the pixel estimate play"},
+        {"split", O::kBoth, kIntegrator, "1", "an integer in 1..64",
+         "splitting (experimental): a vertex whose expected contribution exceeds split-window "
+         "x the pixel's estimate continues as up to this many paths (1: off)"},
+        {"split-window", O::kBoth, kIntegrator, "1", "a positive number",
+         "split: the multiple of the pixel's estimate above which a path splits"},
         {"samples", O::kBoth, kIntegrator, "sequence", "\"sequence\" or \"independent\"",
          "passes continue one low-discrepancy sequence per pixel, or draw independent sets "
          "(exactly unbiased, less stratified)"},
@@ -71,6 +76,15 @@ const std::vector<GuideOption>& guideOptions() {
          "hemisphere's learned light"},
         {"tree-depth", O::kHemi, kField, "12", "an integer in 1..16",
          "directions=tree: the deepest level (leaf edge 2^-depth of the square)"},
+        {"spots", O::kHemi, kField, "0", "an integer in 0..16",
+         "narrow lobes per hemisphere aimed at small bright spots (highlights of lights on "
+         "near-specular surfaces) that a stratum is too coarse for (experimental; 0: off; no "
+         "--guide-save)"},
+        {"spot-share", O::kHemi, kField, "0.5", "a number in (0, 1]",
+         "spots: the largest probability of the lobes within the guide"},
+        {"spot-outlier", O::kHemi, kField, "10", "a number >= 1",
+         "spots: a direction's light at the next vertex must exceed this multiple of its "
+         "stratum's estimate to shape a lobe"},
         // vdb only.
         {"voxel", O::kVdb, kField, "sqrt(area / 1024) as the edge",
          "a voxel count along the longest axis, 1..4096",

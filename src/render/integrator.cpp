@@ -111,6 +111,20 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
         }
         settings->rouletteWindow = w;
     }
+    auto split = config.params.find("split");
+    if (split != config.params.end()) {
+        float v = 0.f;
+        if (!parseFloat(split->second, &v) || !(v >= 1.f && v <= 64.f))
+            return badOption("split", split->second, error);
+        settings->splitMax = int(v);
+    }
+    auto splitWindow = config.params.find("split-window");
+    if (splitWindow != config.params.end()) {
+        float v = 0.f;
+        if (!parseFloat(splitWindow->second, &v) || !(v > 0.f && v <= 1e6f))
+            return badOption("split-window", splitWindow->second, error);
+        settings->splitWindow = v;
+    }
     auto learn = config.params.find("learn");
     if (learn != config.params.end() && learn->second != "all" &&
         !parseSampleCount(learn->second, &settings->learnSpp)) {
@@ -465,7 +479,18 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         s.pm.medium = scene_.cameraMedium;
         s.pm.rng = &rng;
     }
-    for (int bounces = 0;; ++bounces) {
+    // Split paths (GuideSettings::splitMax): the branches waiting to be traced, each a path
+    // state after its direction sample at bounce `bounces`.
+    struct Branch {
+        PathState s;
+        int bounces;
+    };
+    constexpr int kMaxBranches = 32;
+    Branch branches[kMaxBranches];
+    int numBranches = 0, startBounces = 0;
+    int branchesLeft = kMaxBranches;  // per camera path: its work stays bounded
+    for (;;) {
+    for (int bounces = startBounces;; ++bounces) {
         // The closest hit. The path's last direction (no vertex after it) brings back only
         // the emission it hits, weighted against this vertex's next-event estimation: the
         // learned Q, the light of whole returns, overstates what it can find there, and its
@@ -585,13 +610,53 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         bool deferTarget;
         {
             GuideTimer timer(s.clock);
+            rec.arrived(si.p, s.L);
             deferTarget =
                 rec.surfaceReached(si, bsdf, guide, canGuide, lobes.all, emitted, lastVertex);
         }
         if (lastVertex) break;
 
+        // Splitting: how many paths continue from here (r, rounded stochastically).
+        float splitRatio = 1.f;
+        int splitCount = 1;
+        if (guide_.splitMax > 1 && sampleGuide.valid() && pixelEstimate > 0.f && !media &&
+            !bsdf.subsurface() && guideConfidence(vertexGuide) >= kRouletteConfidence) {
+            const float expected = luminance(s.beta) * luminance(bsdf.f(si.wo, query.n)) *
+                                   sampleGuide.irradianceEstimate(query.n);
+            const float r = expected / (guide_.splitWindow * pixelEstimate);
+            if (r > 1.f && std::isfinite(r)) {
+                // At most as many branches as the stack holds: E[count] = ratio exactly.
+                splitRatio = std::min({r, float(guide_.splitMax), float(1 + branchesLeft)});
+                splitCount = int(splitRatio);
+                if (sampler.get1D() < splitRatio - float(splitCount)) ++splitCount;
+                if (splitCount > 1) rec.split();
+                branchesLeft -= splitCount - 1;
+            }
+        }
+        for (int k = 1; k < splitCount; ++k) {
+            DirectionSample dk = sampleDirection(si, bsdf, vertexGuide, sampler);
+            if (!(dk.pdf > 0.f) || isBlack(dk.f)) continue;
+            Branch& b = branches[numBranches];
+            b.s = s;
+            b.s.beta *= dk.f * (std::abs(glm::dot(dk.wi, si.ns)) / (dk.pdf * splitRatio));
+            if (!isFinite(b.s.beta)) continue;
+            b.s.dirPdf = dk.pdf;
+            b.s.specularBounce = dk.specular;
+            if (dk.specular && dk.transmission) {
+                float eta = bsdf.eta();
+                b.s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
+            }
+            b.s.prev = LightSampleContext{si.p, si.ng};
+            b.s.ray.o = spawnOrigin(si, dk.wi, originScale_);
+            b.s.ray.d = dk.wi;
+            b.s.ray.tMax = Infinity;
+            b.bounces = bounces;
+            ++numBranches;
+        }
+
         // The next direction (the guiding seam), and what the guide learns from it.
         DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
+
         {
             GuideTimer timer(s.clock);
             rec.surfaceSampled(deferTarget, si, guide, ds, emitted);
@@ -603,6 +668,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         }
         const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
         s.beta *= weight;
+        if (splitRatio > 1.f) s.beta /= splitRatio;  // one of about r branches
         s.dirPdf = ds.pdf;
         s.specularBounce = ds.specular;
         {
@@ -643,6 +709,14 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             continue;
         }
         if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) break;
+    }
+    if (numBranches == 0) break;
+    // The next branch, with the light of every branch so far.
+    const Spectrum L = s.L;
+    --numBranches;
+    s = branches[numBranches].s;
+    s.L = L;
+    startBounces = branches[numBranches].bounces + 1;
     }
     {
         GuideTimer timer(s.clock);

@@ -113,6 +113,13 @@ struct GuideSettings {
     bool adjointRoulette = true;
     // rr-window: the weight window's lower edge as a share of the pixel estimate.
     float rouletteWindow = 0.1f;
+    // split=N (experimental, 1 = off): a guided surface vertex whose expected contribution
+    // (throughput x f(wo, n) x the learned irradiance) exceeds splitWindow x the pixel's
+    // estimate continues as up to N paths, each with 1 / r of the throughput (r the ratio,
+    // rounded stochastically): the splitting half of Vorba and Krivanek 2016. The branches
+    // after the split train nothing.
+    int splitMax = 1;
+    float splitWindow = 1.f;
 };
 
 class Rng;

@@ -18,10 +18,12 @@ PathRecorder::PathRecorder(const GuideSettings& guide, int slot)
       bootstrap_(learn_ && !guide.pathTarget), returns_(learn_ && guide.pathTarget),
       sampledTarget_(guide.sampledTarget) {
     if (learn_) slot_ = guide.field->slot(slot);
+    spots_ = returns_ && guide.field->learnsSpots();
 }
 
 void PathRecorder::mediumScattered(const guiding::VertexGuide& guide, const DirectionSample& ds) {
     if (!learn_) return;
+    spotPending_ = false;  // the last return vertex's direction ended in the medium
     // Eq. 1 for the previous vertex, with the one-sample estimate of the light scattered
     // here: Q(p, w') phase(w') / pdf(w').
     if (pending_.active() && guide.valid() && ds.pdf > 0.f) {
@@ -85,6 +87,16 @@ float PathRecorder::scatteredTarget(const SurfaceInteraction& si, const BSDF& bs
         float cosj = glm::dot(wj, c->n);
         return cosj > 0.f ? luminance(c->bsdf.f(c->wo, wj)) * cosj : 0.f;
     });
+}
+
+void PathRecorder::spotReached(const Vec3& p, const Spectrum& L) {
+    spotPending_ = false;
+    const ReturnVertex& v = ret_.v[numRet_ - 1];
+    const Spectrum d = L - v.L;
+    Spectrum li(0.f);
+    for (int c = 0; c < 3; ++c) li[c] = v.beta[c] > 0.f ? d[c] / v.beta[c] : 0.f;
+    const float light = luminance(li);
+    if (light > 0.f && std::isfinite(light)) slot_.recordSpot(v.guide, v.w, p, light, v.bin);
 }
 
 void PathRecorder::finish(const Spectrum& L) {

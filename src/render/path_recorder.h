@@ -71,7 +71,7 @@ public:
     // sampleGuide (mix=learn), with the path's L and throughput so far.
     void selectionVertex(const guiding::VertexGuide& sampleGuide, const DirectionSample& ds,
                          const Spectrum& L, const Spectrum& beta) {
-        if (!learnSelection_ || !sampleGuide.valid() || numSel_ >= kMaxSelectionVertices)
+        if (!learnSelection_ || split_ || !sampleGuide.valid() || numSel_ >= kMaxSelectionVertices)
             return;
         sel_.v[numSel_++] = SelectionVertex{
             sampleGuide, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},
@@ -84,8 +84,12 @@ public:
     void surfaceScattered(const guiding::VertexGuide& guide, bool learnsReturn, bool canGuide,
                           const DirectionSample& ds, const Spectrum& weight, const Spectrum& L,
                           const Spectrum& beta) {
-        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices)
+        spotPending_ = false;
+        if (split_) return;
+        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices) {
             ret_.v[numRet_++] = ReturnVertex{guide, ds.bin, ds.wi, L, beta};
+            spotPending_ = spots_;
+        }
         if (!learn_) return;
         if (bootstrap_ && guide.valid() && !ds.transmission) {
             pending_ = PendingRecord();
@@ -104,6 +108,20 @@ public:
     // Returns stay valid: the light gathered after a vertex is still what its direction
     // brought back.
     void subsurfaceScattered() { pending_ = PendingRecord(); }
+    // The path arrived at surface point p (after the next-event estimation there, or at the
+    // depth limit, with L the radiance so far): for a field that learns spots, what the last
+    // return vertex's direction found here (GuidingField::recordSpot).
+    void arrived(const Vec3& p, const Spectrum& L) {
+        if (spotPending_) spotReached(p, L);
+    }
+    // The path splits (GuideSettings::splitMax): the vertices after this one train nothing
+    // (their returns would mix the branches' light); the returns before it learn the light of
+    // all branches.
+    void split() {
+        split_ = true;
+        spotPending_ = false;
+        pending_ = PendingRecord();
+    }
     // The path ended with radiance L: records the returns and the selection samples.
     void finish(const Spectrum& L);
 
@@ -170,8 +188,13 @@ private:
     float scatteredTarget(const SurfaceInteraction& si, const BSDF& bsdf,
                           const guiding::VertexGuide& guide, const Vec3& woY) const;
 
+    void spotReached(const Vec3& p, const Spectrum& L);
+
     guiding::TrainingSlot slot_;
     bool learn_, learnSelection_, bootstrap_, returns_, sampledTarget_;
+    bool spots_ = false;        // the field learns spots (returns only)
+    bool spotPending_ = false;  // the last return vertex waits for its next vertex
+    bool split_ = false;        // the path has split: no more training
     PendingRecord pending_;
     ReturnVertices ret_;
     int numRet_ = 0;

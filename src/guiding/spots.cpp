@@ -1,0 +1,216 @@
+#include "guiding/spots.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "util/math.h"
+
+namespace rlpbrt::guiding {
+
+namespace {
+
+// The lobes' concentration: from the records' spread (E[1 - cos] = 1 / kappa for a
+// von Mises-Fisher lobe), widened by kWiden, within [kMinKappa, kMaxKappa] (a cone of about
+// 18 to 0.6 degrees). A new lobe is matched with kInitKappa (about 2 degrees).
+constexpr double kWiden = 2.0;
+constexpr float kMinKappa = 20.f;
+constexpr float kMaxKappa = 2e4f;
+constexpr float kInitKappa = 1600.f;
+// A candidate joins a lobe within this many lobe widths (1 - cos < kMatch / kappa), and at
+// least within kMatchFloor (about 3 degrees).
+constexpr float kMatch = 8.f;
+constexpr float kMatchFloor = 1.4e-3f;
+// The lobes' share of the guide is at least this where a region has active lobes.
+constexpr double kMinShare = 0.05;
+
+}  // namespace
+
+float vmfPdf(float kappa, float cosTheta) {
+    // kappa / (2 pi (1 - e^-2kappa)) e^(kappa (cos - 1)); -expm1 keeps small kappa exact.
+    const float norm = kappa / (TwoPi * -std::expm1(-2.f * kappa));
+    return norm * std::exp(kappa * (std::min(cosTheta, 1.f) - 1.f));
+}
+
+glm::vec3 vmfSample(const glm::vec3& mean, float kappa, glm::vec2 u) {
+    // 1 - cos = -log(v + (1 - v) e^-2kappa) / kappa with v = 1 - u.x in (0, 1].
+    const float v = 1.f - u.x;
+    const float oneMinusCos =
+        std::clamp(-std::log(v + (1.f - v) * std::exp(-2.f * kappa)) / kappa, 0.f, 2.f);
+    const float cosTheta = 1.f - oneMinusCos;
+    const float sinTheta = std::sqrt(std::max(0.f, oneMinusCos * (2.f - oneMinusCos)));
+    const float phi = TwoPi * u.y;
+    const Frame f = Frame::fromZ(mean);
+    return glm::normalize(f.toWorld(
+        glm::vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta)));
+}
+
+void SpotLobes::reset(size_t regions, const SpotSettings& settings) {
+    settings_ = settings;
+    settings_.perRegion = std::clamp(settings.perRegion, 1, 255);
+    lobes_.assign(regions * size_t(settings_.perRegion), Lobe());
+    lobeCount_.assign(regions, 0);
+    active_.assign(regions * size_t(settings_.perRegion), Active());
+    activeCount_.assign(regions, 0);
+    share_.assign(regions, 0.f);
+    slots_.clear();
+}
+
+glm::vec3 SpotLobes::lobeDirection(const Active& a, const glm::vec3& x) {
+    if (!a.aimsAtPoint) return a.axis;
+    const glm::vec3 d = a.axis - x;
+    const float len2 = glm::dot(d, d);
+    // At the point itself (or on a degenerate axis) the lobe points along +z: any fixed
+    // direction keeps sample() and pdf() consistent.
+    return len2 > 0.f && std::isfinite(len2) ? d * (1.f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
+}
+
+glm::vec3 SpotLobes::sample(int region, const glm::vec3& x, glm::vec2 u, float uLobe) const {
+    const Active* a = &active_[size_t(region) * size_t(settings_.perRegion)];
+    const int n = activeCount_[size_t(region)];
+    if (n == 0) return glm::vec3(0.f);
+    int i = 0;
+    while (i + 1 < n && !(uLobe < a[i].cumWeight)) ++i;
+    return vmfSample(lobeDirection(a[i], x), a[i].kappa, u);
+}
+
+float SpotLobes::pdf(int region, const glm::vec3& x, const glm::vec3& w) const {
+    if (region < 0 || size_t(region) >= activeCount_.size()) return 0.f;
+    const Active* a = &active_[size_t(region) * size_t(settings_.perRegion)];
+    const int n = activeCount_[size_t(region)];
+    float p = 0.f;
+    for (int i = 0; i < n; ++i) {
+        // e^(kappa (cos - 1)) below e^-40 adds nothing to a float sum with the strata's
+        // densities: skip the exponential.
+        const float e = a[i].kappa * (std::min(glm::dot(w, lobeDirection(a[i], x)), 1.f) - 1.f);
+        if (e > -40.f) p += a[i].norm * std::exp(e);
+    }
+    return p;
+}
+
+void SpotLobes::beginPass(int numSlots) {
+    slots_.resize(size_t(std::max(numSlots, 0)));
+    for (auto& s : slots_) s.clear();
+}
+
+void SpotLobes::record(int slot, int region, const glm::vec3& x, const glm::vec3& w,
+                       const glm::vec3& hit, float light, float reference) {
+    if (slot < 0 || size_t(slot) >= slots_.size() || region < 0 ||
+        size_t(region) >= share_.size())
+        return;
+    if (!(light > float(settings_.outlier) * std::max(reference, 0.f)) || !std::isfinite(light))
+        return;
+    if (!std::isfinite(hit.x + hit.y + hit.z + x.x + x.y + x.z + w.x + w.y + w.z)) return;
+    slots_[size_t(slot)].push_back(Candidate{uint32_t(region), x, w, hit, light});
+}
+
+void SpotLobes::mergeCandidates() {
+    const int k = settings_.perRegion;
+    for (auto& slot : slots_) {
+        for (const Candidate& c : slot) {
+            Lobe* l = &lobes_[size_t(c.region) * size_t(k)];
+            uint8_t& n = lobeCount_[c.region];
+            int best = -1;
+            float bestErr = 0.f;
+            float errP = 0.f, errD = 0.f;
+            for (int i = 0; i < n; ++i) {
+                const glm::vec3 dp = l[i].point - c.x;
+                const float len = glm::length(dp);
+                const float ep = len > 0.f ? 1.f - glm::dot(c.w, dp / len) : 2.f;
+                const float ed = 1.f - glm::dot(c.w, l[i].dir);
+                const float e = std::min(ep, ed);
+                const float kappa = l[i].kappa > 0.f ? l[i].kappa : kInitKappa;
+                if (e < std::max(kMatch / kappa, kMatchFloor) && (best < 0 || e < bestErr)) {
+                    best = i;
+                    bestErr = e;
+                    errP = ep;
+                    errD = ed;
+                }
+            }
+            if (best < 0) {
+                if (n < k) {
+                    best = n++;
+                } else {
+                    // Replace the faintest lobe seen once, if this candidate is brighter.
+                    for (int i = 0; i < n; ++i)
+                        if (l[i].hits <= 1 && (best < 0 || l[i].sumLight < l[best].sumLight))
+                            best = i;
+                    if (best < 0 || !(double(c.light) > l[best].sumLight)) continue;
+                }
+                l[best] = Lobe();
+                l[best].point = c.hit;
+                l[best].dir = c.w;
+                errP = errD = 0.f;
+            }
+            Lobe& lobe = l[best];
+            const double t = c.light;
+            lobe.sumLight += t;
+            lobe.sumPoint += t * glm::dvec3(c.hit);
+            lobe.sumDir += t * glm::dvec3(c.w);
+            lobe.sumErrPoint += t * double(std::max(errP, 0.f));
+            lobe.sumErrDir += t * double(std::max(errD, 0.f));
+            ++lobe.hits;
+        }
+        slot.clear();
+    }
+}
+
+void SpotLobes::refit(size_t region, double regionTotal) {
+    Lobe* l = &lobes_[region * size_t(settings_.perRegion)];
+    Active* act = &active_[region * size_t(settings_.perRegion)];
+    const int n = lobeCount_[region];
+    double active = 0.0;
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        Lobe& lobe = l[i];
+        lobe.kappa = 0.f;
+        if (lobe.hits < 2 || !(lobe.sumLight > 0.0)) continue;
+        const glm::dvec3 d = lobe.sumDir;
+        const double len = glm::length(d);
+        if (!(len > 0.0)) continue;
+        lobe.point = glm::vec3(lobe.sumPoint / lobe.sumLight);
+        lobe.dir = glm::vec3(d / len);
+        const double errP = lobe.sumErrPoint / lobe.sumLight;
+        const double errD = lobe.sumErrDir / lobe.sumLight;
+        const double err = std::max(std::min(errP, errD), 1e-9);
+        lobe.kappa = float(std::clamp(1.0 / (kWiden * err), double(kMinKappa), double(kMaxKappa)));
+        Active& a = act[m++];
+        a.aimsAtPoint = errP <= errD;
+        a.axis = a.aimsAtPoint ? lobe.point : lobe.dir;
+        a.kappa = lobe.kappa;
+        a.norm = float(lobe.sumLight);  // normalised below
+        active += lobe.sumLight;
+    }
+    activeCount_[region] = uint8_t(m);
+    if (m == 0) {
+        share_[region] = 0.f;
+        return;
+    }
+    double cum = 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double w = double(act[i].norm) / active;
+        cum += w;
+        act[i].cumWeight = i + 1 < m ? float(cum) : 1.f;
+        act[i].norm = float(w) * vmfPdf(act[i].kappa, 1.f);
+    }
+    const double share = regionTotal > 0.0 ? active / regionTotal : settings_.maxShare;
+    share_[region] = float(std::clamp(share, kMinShare, settings_.maxShare));
+}
+
+size_t SpotLobes::bytes() const {
+    return lobes_.capacity() * sizeof(Lobe) + lobeCount_.capacity() + share_.capacity() * 4 +
+           active_.capacity() * sizeof(Active) + activeCount_.capacity();
+}
+
+size_t SpotLobes::activeRegions() const {
+    size_t n = 0;
+    for (float s : share_) n += s > 0.f;
+    return n;
+}
+
+size_t SpotLobes::activeLobes() const {
+    size_t n = 0;
+    for (uint8_t c : activeCount_) n += c;
+    return n;
+}
+
+}  // namespace rlpbrt::guiding

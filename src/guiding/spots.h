@@ -1,0 +1,116 @@
+// Spot lobes: small bright sources that a region's strata are far too coarse for, learned
+// per region as narrow von Mises-Fisher lobes (docs/GUIDING.md, "spots"). A spot is where a
+// direction sampled at the region found, at the very next vertex, far more light than its
+// stratum's learned estimate: typically a highlight of the sun on a near-specular surface,
+// whose reflected light reaches the region only through a cone much smaller than a stratum.
+// Each lobe is aimed either at a point (the spot's mean position: the direction then depends
+// on the vertex, parallax-aware, right for curved highlights) or along a fixed direction (a
+// flat mirror's reflected sun), whichever the records fit better; its width is fitted to the
+// records' spread. Standard library and GLM only; knows nothing of the strata or the scene.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace rlpbrt::guiding {
+
+struct SpotSettings {
+    int perRegion = 4;        // lobes per region
+    double maxShare = 0.5;    // the largest probability of the lobes within the guide
+    double outlier = 10.0;    // a record is a spot candidate above outlier x its stratum's Q
+};
+
+// The von Mises-Fisher distribution on the sphere around unit `mean` with concentration
+// kappa > 0: density kappa / (2 pi (1 - e^(-2 kappa))) e^(kappa (cos - 1)).
+float vmfPdf(float kappa, float cosTheta);
+glm::vec3 vmfSample(const glm::vec3& mean, float kappa, glm::vec2 u);
+
+class SpotLobes {
+public:
+    void reset(size_t regions, const SpotSettings& settings);
+    size_t regions() const { return share_.size(); }
+
+    // The probability of sampling the lobes at a region (0: none there). Frozen per pass.
+    float share(int region) const {
+        return region >= 0 && size_t(region) < share_.size() ? share_[size_t(region)] : 0.f;
+    }
+    // Starts loading a region's lobes (a hint).
+    void prefetch(int region) const {
+        if (region >= 0 && size_t(region) < activeCount_.size())
+            __builtin_prefetch(&active_[size_t(region) * size_t(settings_.perRegion)]);
+    }
+    // A direction from the lobes of `region` seen from x (share(region) > 0), u and uLobe in
+    // [0, 1); its density is pdf(region, x, w).
+    glm::vec3 sample(int region, const glm::vec3& x, glm::vec2 u, float uLobe) const;
+    // The lobes' solid-angle density at unit w seen from x (the lobes' mixture, weights
+    // normalised; 0 where share(region) is 0).
+    float pdf(int region, const glm::vec3& x, const glm::vec3& w) const;
+
+    // Learning. A candidate: at a vertex x of `region`, unit direction w reached `hit`, whose
+    // light (emission and next-event estimation there, luminance) was `light`, against the
+    // estimate `reference` of w's stratum. Kept if light > outlier x reference. Thread-safe
+    // across slots.
+    void beginPass(int numSlots);
+    void record(int slot, int region, const glm::vec3& x, const glm::vec3& w,
+                const glm::vec3& hit, float light, float reference);
+    // Merges the candidates in slot order and refits the lobes; regionTotal(r) gives the sum
+    // of every target region r has learned (its strata's Q x visits), against which the
+    // lobes' share is set.
+    template <class Total>
+    void endPass(Total&& regionTotal) {
+        mergeCandidates();
+        for (size_t r = 0; r < share_.size(); ++r)
+            if (lobeCount_[r] > 0) refit(r, regionTotal(r));
+    }
+
+    size_t bytes() const;
+    // Regions with at least one active lobe, and active lobes in all.
+    size_t activeRegions() const;
+    size_t activeLobes() const;
+
+private:
+    // What a lobe learns, accumulated over passes (weighted by the candidates' light), and
+    // its parameters as of the last endPass (for matching candidates).
+    struct Lobe {
+        glm::vec3 point{0.f};  // mean hit point
+        glm::vec3 dir{0.f};    // mean direction (unit)
+        float kappa = 0.f;     // 0: not active yet
+        double sumLight = 0.0;
+        glm::dvec3 sumPoint{0.0}, sumDir{0.0};
+        double sumErrPoint = 0.0, sumErrDir = 0.0;
+        uint32_t hits = 0;
+    };
+    // What sampling and pdf read, frozen per pass: a region's active lobes, packed (two to a
+    // cache line).
+    struct Active {
+        glm::vec3 axis{0.f};  // the point aimed at, or the direction
+        float kappa = 0.f;
+        float norm = 0.f;     // weight x kappa / (2 pi (1 - e^-2kappa))
+        float cumWeight = 0.f;  // the selection CDF up to this lobe
+        uint32_t aimsAtPoint = 0;
+        float pad = 0.f;
+    };
+    struct Candidate {
+        uint32_t region;
+        glm::vec3 x, w, hit;
+        float light;
+    };
+    // The lobe's direction seen from x (unit; the last fitted direction `fallback` if x is
+    // at its point).
+    static glm::vec3 lobeDirection(const Active& a, const glm::vec3& x);
+    void mergeCandidates();
+    void refit(size_t region, double regionTotal);
+
+    SpotSettings settings_;
+    std::vector<Lobe> lobes_;           // regions x perRegion
+    std::vector<uint8_t> lobeCount_;    // used lobes per region
+    std::vector<Active> active_;        // regions x perRegion, the first activeCount_ used
+    std::vector<uint8_t> activeCount_;
+    std::vector<float> share_;          // frozen per pass
+    std::vector<std::vector<Candidate>> slots_;
+};
+
+}  // namespace rlpbrt::guiding

@@ -1,0 +1,182 @@
+// Tests of the spot lobes (guiding/spots.h) and of hemi's mixture of strata and lobes
+// (spots=N): the von Mises-Fisher lobe's sampling against its pdf (chi-square) and its unit
+// integral, a trained field's sampleAt against pdfAt over the sphere, trained and untrained,
+// and the lobes' samples kept out of the strata's means.
+#include "guiding/spots.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "guiding/hemi.h"
+#include "guiding/test_scenes.h"
+#include "render/chi2.h"
+
+namespace rlpbrt::guiding {
+namespace {
+
+using test::planeScene;
+using test::trainBright;
+
+// The integral of vmfPdf over the sphere: 2 pi times a quadrature over t = 1 - cos(theta) in
+// [0, 2] on a geometric grid (the density falls as e^(-kappa t)).
+double vmfIntegral(float kappa) {
+    double sum = 0.0, t0 = 0.0;
+    for (double t1 = 1e-9; t0 < 2.0; t1 = std::min(2.0, t1 * 1.001)) {
+        const double tm = 0.5 * (t0 + t1);
+        sum += double(vmfPdf(kappa, float(1.0 - tm))) * (t1 - t0);
+        t0 = t1;
+    }
+    return 2.0 * 3.14159265358979 * sum;
+}
+
+TEST(VonMisesFisher, PdfIntegratesToOne) {
+    for (float kappa : {0.5f, 20.f, 1600.f, 2e4f})
+        EXPECT_NEAR(vmfIntegral(kappa), 1.0, 2e-3) << "kappa " << kappa;
+}
+
+// cos(theta) about the mean falls in bins of t = 1 - cos with probabilities from the closed
+// form (e^(-kappa t0) - e^(-kappa t1)) / (1 - e^(-2 kappa)); phi is uniform.
+TEST(VonMisesFisher, SamplesMatchThePdfExactly) {
+    const glm::vec3 mean = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+    const Frame frame = Frame::fromZ(mean);
+    for (float kappa : {0.5f, 20.f, 1600.f, 2e4f}) {
+        const int tBins = 16, phiBins = 8, n = 400000;
+        std::vector<double> observed(size_t(tBins * phiBins), 0.0), expected(observed.size());
+        // Bin edges at quantiles of t, so that every bin expects the same mass.
+        std::vector<double> edges(size_t(tBins + 1));
+        const double norm = -std::expm1(-2.0 * double(kappa));
+        for (int i = 0; i <= tBins; ++i)
+            edges[size_t(i)] = -std::log1p(-norm * double(i) / tBins) / double(kappa);
+        edges[size_t(tBins)] = 2.0;
+        for (double& e : expected) e = double(n) / double(tBins * phiBins);
+        std::mt19937_64 rng(17 + uint64_t(kappa));
+        std::uniform_real_distribution<float> uni(0.f, 1.f);
+        for (int i = 0; i < n; ++i) {
+            const glm::vec3 w = vmfSample(mean, kappa, glm::vec2(uni(rng), uni(rng)));
+            ASSERT_NEAR(glm::length(w), 1.f, 1e-4f);
+            const glm::vec3 l = frame.toLocal(w);
+            const double t = 1.0 - double(l.z);
+            int tb = int(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin()) - 1;
+            tb = std::clamp(tb, 0, tBins - 1);
+            double phi = std::atan2(double(l.y), double(l.x));
+            if (phi < 0.0) phi += 2.0 * 3.14159265358979;
+            const int pb = std::clamp(int(phi / (2.0 * 3.14159265358979) * phiBins), 0, phiBins - 1);
+            observed[size_t(tb * phiBins + pb)] += 1.0;
+        }
+        // At kappa 2e4 float directions resolve t down to ~1e-7 (bins of width 1e-6 and
+        // up): the rounding of the frame moves few samples across an edge.
+        chi2::Result r = chi2::testCounts(observed, expected, 0.01, 4);
+        EXPECT_TRUE(r.passed) << "kappa " << kappa << ": " << r.message;
+    }
+}
+
+std::unique_ptr<HemiField> makeHemi(std::map<std::string, std::string> params) {
+    return test::makeField<HemiField>("hemi", planeScene(), std::move(params));
+}
+
+// Candidates of a spot: from points x of the region around xc, directions to hits scattered
+// by `jitter` around `spot`, each bringing `light`.
+void trainSpot(HemiField& f, int region, const glm::vec3& xc, const glm::vec3& spot,
+               float jitter, float light, int passes, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<float> g(0.f, 1.f);
+    for (int p = 0; p < passes; ++p) {
+        f.beginPass(1);
+        for (int i = 0; i < 200; ++i) {
+            const glm::vec3 x = xc + 0.05f * glm::vec3(g(rng), g(rng), 0.f);
+            const glm::vec3 hit = spot + jitter * glm::vec3(g(rng), g(rng), g(rng));
+            f.recordSpot(0, region, x, glm::normalize(hit - x), hit, light);
+        }
+        f.endPass();
+    }
+}
+
+chi2::SphereResult sphereAt(const GuidingField& f, int region, const glm::vec3& x,
+                            uint64_t seed) {
+    chi2::SphereOptions opt;
+    opt.sampleCount = 200000;
+    opt.thetaRes = 24;
+    opt.phiRes = 48;
+    opt.seed = seed;
+    return chi2::testSphere(
+        [&](const glm::vec3& u) {
+            chi2::SphereSample s;
+            s.dir = f.sampleAt(region, x, glm::vec2(u.x, u.y), u.z, &s.pdf);
+            return s;
+        },
+        [&](const glm::vec3& w) { return f.pdfAt(region, x, w); }, opt);
+}
+
+TEST(HemiSpots, UntrainedFieldIsTheStrata) {
+    auto f = makeHemi({{"points", "16"}, {"spots", "4"}, {"warmup", "0"}});
+    ASSERT_TRUE(f);
+    const glm::vec3 x(0.5f, 0.5f, 0.f), w = glm::normalize(glm::vec3(0.2f, 0.1f, 1.f));
+    EXPECT_EQ(f->pdfAt(4, x, w), f->pdf(4, w));
+    EXPECT_EQ(f->spots()->activeLobes(), 0u);
+    chi2::SphereResult r = sphereAt(*f, 4, x, 11);
+    EXPECT_TRUE(r.passed) << r.message;
+    EXPECT_NEAR(r.pdfIntegral, 1.0, 2e-3);
+}
+
+TEST(HemiSpots, TrainedLobesAimAtTheSpotAndMatchTheirPdf) {
+    auto f = makeHemi({{"points", "16"}, {"spots", "2"}, {"warmup", "0"}});
+    ASSERT_TRUE(f);
+    const int region = 4;
+    trainBright(*f, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);  // Q ~ 0.05 .. 100
+    const glm::vec3 xc = f->regionPosition(region);
+    const glm::vec3 spot = xc + glm::vec3(0.6f, -0.3f, 0.5f);
+    trainSpot(*f, region, xc, spot, 0.02f, 1e4f, 2, 5);
+    ASSERT_GT(f->spots()->activeLobes(), 0u);
+    const float share = f->spots()->share(region);
+    EXPECT_GT(share, 0.f);
+    EXPECT_LE(share, 0.5f);
+    // From two places in the region the lobe aims at the spot (a point: the records came
+    // from many places), so the pdf toward it is far above the strata's.
+    for (const glm::vec3& x : {xc, xc + glm::vec3(0.08f, 0.05f, 0.f)}) {
+        const glm::vec3 toSpot = glm::normalize(spot - x);
+        EXPECT_GT(f->pdfAt(region, x, toSpot), 20.f * f->pdf(region, toSpot));
+        chi2::SphereResult r = sphereAt(*f, region, x, 21);
+        EXPECT_TRUE(r.passed) << r.message;
+        EXPECT_NEAR(r.pdfIntegral, 1.0, 3e-3);
+    }
+    // Dim candidates (below spot-outlier x the stratum's Q) shape nothing.
+    auto g = makeHemi({{"points", "16"}, {"spots", "2"}, {"warmup", "0"}});
+    trainBright(*g, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);
+    trainSpot(*g, region, xc, spot, 0.02f, 1e-3f, 2, 5);
+    EXPECT_EQ(g->spots()->activeLobes(), 0u);
+}
+
+TEST(HemiSpots, LobeSamplesStayOutOfTheStrata) {
+    auto f = makeHemi({{"points", "16"}, {"spots", "1"}, {"warmup", "0"},
+                       {"spot-share", "1"}});
+    ASSERT_TRUE(f);
+    const int region = 4;
+    trainBright(*f, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);
+    const glm::vec3 xc = f->regionPosition(region);
+    trainSpot(*f, region, xc, xc + glm::vec3(0.f, 0.4f, 0.6f), 0.02f, 1e4f, 2, 7);
+    ASSERT_GT(f->spots()->share(region), 0.f);
+    const std::vector<uint64_t> before = f->visitTable();
+    // Draws with uStratum 0 take the lobes (share > 0); recording them changes no visits.
+    f->beginPass(1);
+    int recorded = 0;
+    for (int i = 0; i < 100; ++i) {
+        float pdf = 0.f;
+        int bin = -1;
+        const glm::vec3 w = f->sampleAt(region, xc, glm::vec2((i + 0.5f) / 100.f, 0.37f), 0.f,
+                                        &pdf, &bin);
+        ASSERT_GT(pdf, 0.f);
+        EXPECT_FLOAT_EQ(pdf, f->pdfAt(region, xc, w));
+        if (bin < 0) continue;  // below the hemisphere
+        f->record(0, region, w, 5.f, bin);
+        ++recorded;
+    }
+    f->endPass();
+    EXPECT_GT(recorded, 0);
+    EXPECT_EQ(f->visitTable(), before);
+}
+
+}  // namespace
+}  // namespace rlpbrt::guiding
