@@ -484,6 +484,12 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     struct Branch {
         PathState s;
         int bounces;
+        int retBase;  // PathRecorder::split's base
+        // The split vertex's guide and the branch's direction, for its return.
+        guiding::VertexGuide guide;
+        int bin;
+        Vec3 wi;
+        bool learnsReturn;
     };
     constexpr int kMaxBranches = 32;
     Branch branches[kMaxBranches];
@@ -618,7 +624,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
 
         // Splitting: how many paths continue from here (r, rounded stochastically).
         float splitRatio = 1.f;
-        int splitCount = 1;
+        int splitCount = 1, retBase = 0;
         if (guide_.splitMax > 1 && sampleGuide.valid() && pixelEstimate > 0.f && !media &&
             !bsdf.subsurface() && guideConfidence(vertexGuide) >= kRouletteConfidence) {
             const float expected = luminance(s.beta) * luminance(bsdf.f(si.wo, query.n)) *
@@ -629,7 +635,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 splitRatio = std::min({r, float(guide_.splitMax), float(1 + branchesLeft)});
                 splitCount = int(splitRatio);
                 if (sampler.get1D() < splitRatio - float(splitCount)) ++splitCount;
-                if (splitCount > 1) rec.split();
+                if (splitCount > 1) retBase = rec.split();
                 branchesLeft -= splitCount - 1;
             }
         }
@@ -651,6 +657,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             b.s.ray.d = dk.wi;
             b.s.ray.tMax = Infinity;
             b.bounces = bounces;
+            b.retBase = retBase;
+            b.guide = guide;
+            b.bin = dk.bin;
+            b.wi = dk.wi;
+            b.learnsReturn = !dk.transmission && !lastDirection;
             ++numBranches;
         }
 
@@ -711,12 +722,21 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) break;
     }
     if (numBranches == 0) break;
+    {
+        GuideTimer timer(s.clock);
+        rec.segmentEnded(s.L, branches[numBranches - 1].retBase);
+    }
     // The next branch, with the light of every branch so far.
     const Spectrum L = s.L;
     --numBranches;
-    s = branches[numBranches].s;
+    const Branch& b = branches[numBranches];
+    s = b.s;
     s.L = L;
-    startBounces = branches[numBranches].bounces + 1;
+    startBounces = b.bounces + 1;
+    {
+        GuideTimer timer(s.clock);
+        rec.branchStarted(b.guide, b.learnsReturn, b.bin, b.wi, s.L, s.beta);
+    }
     }
     {
         GuideTimer timer(s.clock);

@@ -116,8 +116,8 @@ struct GuideSettings {
     // split=N (experimental, 1 = off): a guided surface vertex whose expected contribution
     // (throughput x f(wo, n) x the learned irradiance) exceeds splitWindow x the pixel's
     // estimate continues as up to N paths, each with 1 / r of the throughput (r the ratio,
-    // rounded stochastically): the splitting half of Vorba and Krivanek 2016. The branches
-    // after the split train nothing.
+    // rounded stochastically): the splitting half of Vorba and Krivanek 2016. Each branch
+    // trains on its own light (PathRecorder::split).
     int splitMax = 1;
     float splitWindow = 1.f;
 };

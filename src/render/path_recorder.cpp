@@ -99,14 +99,19 @@ void PathRecorder::spotReached(const Vec3& p, const Spectrum& L) {
     if (light > 0.f && std::isfinite(light)) slot_.recordSpot(v.guide, v.w, p, light, v.bin);
 }
 
-void PathRecorder::finish(const Spectrum& L) {
-    for (int i = 0; i < numRet_; ++i) {
+void PathRecorder::recordReturns(const Spectrum& L, int base) {
+    for (int i = std::max(base, 0); i < numRet_; ++i) {
         const ReturnVertex& v = ret_.v[i];
         const Spectrum d = L - v.L;
         Spectrum li(0.f);
         for (int c = 0; c < 3; ++c) li[c] = v.beta[c] > 0.f ? d[c] / v.beta[c] : 0.f;
         slot_.record(v.guide, v.w, std::max(luminance(li), 0.f), v.bin);
     }
+    numRet_ = std::min(numRet_, std::max(base, 0));
+}
+
+void PathRecorder::finish(const Spectrum& L) {
+    recordReturns(L, 0);
     if (numSel_ > 0) {
         const float lumL = luminance(L);
         for (int i = 0; i < numSel_; ++i) {

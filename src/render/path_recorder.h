@@ -85,12 +85,11 @@ public:
                           const DirectionSample& ds, const Spectrum& weight, const Spectrum& L,
                           const Spectrum& beta) {
         spotPending_ = false;
-        if (split_) return;
         if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices) {
             ret_.v[numRet_++] = ReturnVertex{guide, ds.bin, ds.wi, L, beta};
             spotPending_ = spots_;
         }
-        if (!learn_) return;
+        if (!learn_ || split_) return;
         if (bootstrap_ && guide.valid() && !ds.transmission) {
             pending_ = PendingRecord();
             pending_.guide = guide;
@@ -114,13 +113,34 @@ public:
     void arrived(const Vec3& p, const Spectrum& L) {
         if (spotPending_) spotReached(p, L);
     }
-    // The path splits (GuideSettings::splitMax): the vertices after this one train nothing
-    // (their returns would mix the branches' light); the returns before it learn the light of
-    // all branches.
-    void split() {
+    // The path splits (GuideSettings::splitMax) into branches traced one after another, each
+    // a segment. The returns go on: a vertex learns the light gathered after it within its
+    // own segment (segmentEnded), the vertices before the split the light of all branches
+    // (each branch carries its share 1 / r of the throughput). Eq. 1's pending records and
+    // the selection samples stop. Returns the branches' base: the number of return vertices
+    // before the split, which wait for every branch.
+    int split() {
         split_ = true;
         spotPending_ = false;
         pending_ = PendingRecord();
+        return numRet_;
+    }
+    // A branch of a split path starts: its direction w (bin) was sampled at the vertex of
+    // `guide`, the path's light so far is L and the branch's throughput beta (with its share
+    // 1 / r); like surfaceScattered's return vertex.
+    void branchStarted(const guiding::VertexGuide& guide, bool learnsReturn, int bin,
+                       const Vec3& w, const Spectrum& L, const Spectrum& beta) {
+        spotPending_ = false;
+        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices) {
+            ret_.v[numRet_++] = ReturnVertex{guide, bin, w, L, beta};
+            spotPending_ = spots_;
+        }
+    }
+    // A segment of a split path ended with radiance L (the light of every segment so far):
+    // the return vertices from `base` on (the ended segment's) learn now.
+    void segmentEnded(const Spectrum& L, int base) {
+        spotPending_ = false;
+        recordReturns(L, base);
     }
     // The path ended with radiance L: records the returns and the selection samples.
     void finish(const Spectrum& L);
@@ -189,6 +209,9 @@ private:
                           const guiding::VertexGuide& guide, const Vec3& woY) const;
 
     void spotReached(const Vec3& p, const Spectrum& L);
+    // Records the returns of the vertices from `base` on with the path's light L and drops
+    // them.
+    void recordReturns(const Spectrum& L, int base);
 
     guiding::TrainingSlot slot_;
     bool learn_, learnSelection_, bootstrap_, returns_, sampledTarget_;

@@ -54,6 +54,7 @@ public:
         return 0.f;
     }
     float radiance(int, const glm::vec3&, int) const override { return 0.f; }
+    float irradianceEstimate(int, const glm::vec3&) const override { return irradiance; }
     void beginPass(int) override {}
     void record(int, int region, const glm::vec3& w, float target, int bin) override {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -67,6 +68,7 @@ public:
 
     std::vector<Record> records;
     mutable std::atomic<int> lookups{0}, samples{0};
+    float irradiance = 0.f;  // what irradianceEstimate answers (splitting's expectation)
 
 private:
     std::mutex mutex_;
@@ -101,15 +103,19 @@ std::unique_ptr<Scene> buildPlane(int maxDepth = 2) {
     return scene;
 }
 
-// Renders 2000 paths straight down at the plane into `field`; returns its records.
+// Renders 2000 paths straight down at the plane into `field`; returns its records. split:
+// GuideSettings::splitMax, with a window that splits every path at its guided vertex.
 std::vector<RecordingField::Record> train(const Scene& scene, bool pathTarget,
-                                          RecordingField* into = nullptr) {
+                                          RecordingField* into = nullptr, int split = 1) {
     RecordingField local;
     RecordingField& field = into ? *into : local;
     GuideSettings gs;
     gs.field = &field;
     gs.mix = 0.5f;
     gs.pathTarget = pathTarget;
+    gs.splitMax = split;
+    gs.splitWindow = 1e-3f;
+    field.irradiance = split > 1 ? 1.f : 0.f;
     PathIntegrator integrator(scene, gs);
     IndependentSampler sampler(1, 3);
     PathStats stats;
@@ -118,7 +124,7 @@ std::vector<RecordingField::Record> train(const Scene& scene, bool pathTarget,
         sampler.startPixelSample(i % 40, i / 40, 0);
         const Ray ray(Vec3(0.01f * float(i % 40) - 0.2f, 0.01f * float(i / 40) - 0.25f, 1.f),
                       Vec3(0.f, 0.f, -1.f));
-        integrator.Li(ray, sampler, stats, 0);
+        integrator.Li(ray, sampler, stats, 0, /*pixelEstimate=*/split > 1 ? 1.f : 0.f);
     }
     field.endPass();
     return field.records;
@@ -150,6 +156,29 @@ TEST(GuideTargets, PathTargetIsTheMisWeightedReturnOfTheDirection) {
     meanTarget /= double(records.size());
     EXPECT_GT(meanTarget, 0.2);
     EXPECT_LT(meanTarget, 0.95 * lumSky);
+}
+
+// A split path (split=N): every branch's direction is a return of its own, trained on what
+// that branch alone brought back, exactly as an unsplit path's (its throughput's share 1 / r
+// divides out).
+TEST(GuideTargets, EveryBranchOfASplitPathLearnsItsOwnReturn) {
+    auto scene = buildPlane();
+    ASSERT_TRUE(scene);
+    const Light& sky = *scene->lights[0];
+    const auto records = train(*scene, true, nullptr, 4);
+    // About 4 branches per path (each is a record; a few directions leave the hemisphere's
+    // bins or are rejected by the BSDF).
+    ASSERT_GT(records.size(), 3 * 1900u);
+    ASSERT_LT(records.size(), 4 * 2000u + 1);
+    for (const auto& r : records) {
+        ASSERT_GT(r.w.z, 0.f);
+        EXPECT_EQ(r.bin, RecordingField::binOf(r.w)) << r.w.z;
+        const float dirPdf = 0.5f / (2.f * Pi) + 0.5f * r.w.z / Pi;
+        const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
+        const float lightPdf = sky.pdfLi(ctx, r.w, Vec3(0.f), Vec3(0.f));
+        const float expected = luminance(Spectrum(1.f)) * powerHeuristic(1, dirPdf, 1, lightPdf);
+        EXPECT_NEAR(r.target, expected, 2e-3f * expected + 1e-6f) << r.w.z;
+    }
 }
 
 TEST(GuideTargets, EquationOneTargetIsTheFullEmission) {
