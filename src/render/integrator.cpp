@@ -114,7 +114,7 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     auto split = config.params.find("split");
     if (split != config.params.end()) {
         float v = 0.f;
-        if (!parseFloat(split->second, &v) || !(v >= 1.f && v <= 64.f))
+        if (!parseFloat(split->second, &v) || !(v >= 1.f && v <= 64.f) || v != std::floor(v))
             return badOption("split", split->second, error);
         settings->splitMax = int(v);
     }

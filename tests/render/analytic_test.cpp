@@ -575,8 +575,8 @@ TEST(AdjointRoulette, EnclosureStaysExact) { expectAdjointRouletteExact(12, "0.1
 // remainder is below its pixel's estimate is at risk).
 TEST(AdjointRoulette, ShallowPathsStayExact) { expectAdjointRouletteExact(3, "1"); }
 
-// split=N: a path whose expected contribution exceeds split-window x its pixel's estimate
-// continues as several, each with a share of the throughput. With a window of 0.05 nearly
+// split=N (the default 8): a path whose expected contribution exceeds split-window x its
+// pixel's estimate continues as several, each with a share of the throughput. With a window of 0.05 nearly
 // every guided vertex of a 12-bounce enclosure splits (up to 32 branches per camera path):
 // the mean stays the exact series, and the image differs from the unsplit one.
 TEST(Splitting, EnclosureStaysExact) {
@@ -585,7 +585,7 @@ TEST(Splitting, EnclosureStaysExact) {
         Rendered split = renderText(scene, backend,
                                     {{"split", "8"}, {"split-window", "0.05"}, {"warmup", "0"}});
         expectMean(split, series(0.5, 1.0, 12), std::string(backend) + " split=8");
-        Rendered plain = renderText(scene, backend, {{"warmup", "0"}});
+        Rendered plain = renderText(scene, backend, {{"warmup", "0"}, {"split", "1"}});
         ASSERT_TRUE(plain.ok && split.ok);
         EXPECT_NE(plain.image.pixels, split.image.pixels) << backend;
     }
