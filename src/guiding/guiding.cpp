@@ -252,6 +252,10 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             return unknownParam("hemi", key, error);
         }
     }
+    if (hp->spots > 0 && hp->treeDirections) {
+        *error = "guiding backend 'hemi': spots need directions=strata";
+        return false;
+    }
     return true;
 }
 

@@ -496,247 +496,247 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     int numBranches = 0, startBounces = 0;
     int branchesLeft = kMaxBranches;  // per camera path: its work stays bounded
     for (;;) {
-    for (int bounces = startBounces;; ++bounces) {
-        // The closest hit. The path's last direction (no vertex after it) brings back only
-        // the emission it hits, weighted against this vertex's next-event estimation: the
-        // learned Q, the light of whole returns, overstates what it can find there, and its
-        // truncated return would understate Q for the vertices before the last. It samples
-        // the BSDF and records no return (Eq. 1 targets, bootstrapped from Q, are learned
-        // there as everywhere), so a surface vertex looks up a region only before it or to
-        // bootstrap.
-        SurfaceInteraction si;
-        ++stats.rays;
-        const bool found = scene_.intersect(s.ray, &si);
-        const bool lastDirection = bounces + 1 >= maxDepth_;
-        const bool wantsRegion = field && (!lastDirection || rec.bootstraps());
-        // The lookup below reads a table entry for si.p: start loading it (a cache miss
-        // otherwise; the material evaluation runs in between).
-        guiding::VertexQuery query;
-        if (found && wantsRegion) {
-            GuideTimer timer(s.clock);
-            query.p = si.p;
-            if (guide_.patches) query.patch = guide_.patches->key(si);
-            field->prefetch(query);
-        }
-
-        // Media: a free flight to the hit; a scattering event is a medium vertex.
-        if (media && s.pm.medium >= 0) {
-            const Step step = mediumStep(s, found, si, bounces, sampler, stats, rec);
-            if (step == Step::End) break;
-            if (step == Step::Scattered) continue;
-        }
-
-        // Emission reached by the previous scattering (or seen by the camera), weighted by
-        // MIS against next-event estimation.
-        if (!found) {
-            float envLum = 0.f;
-            for (int idx : scene_.infiniteLights) {
-                const Light& light = *scene_.lights[size_t(idx)];
-                Spectrum Le = light.Le(s.ray.d);
-                if (isBlack(Le)) continue;
-                envLum += luminance(Le);
-                if (bounces == 0 || s.specularBounce) {
-                    s.L += s.beta * Le;
-                } else {
-                    float lightPdf = lights_->pmf(s.prev.p, idx) *
-                                     light.pdfLi(s.prev, s.ray.d, Vec3(0.f), Vec3(0.f));
-                    s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
-                }
-            }
-            GuideTimer timer(s.clock);
-            rec.escaped(envLum);
-            break;
-        }
-        float emitted = 0.f;
-        if (si.light >= 0) {
-            const Light& light = *scene_.lights[size_t(si.light)];
-            Spectrum Le = light.L(si.p, si.ng, si.uv, si.wo);
-            if (!isBlack(Le)) {
-                emitted = luminance(Le);
-                if (bounces == 0 || s.specularBounce) {
-                    s.L += s.beta * Le;
-                } else {
-                    float lightPdf = lights_->pmf(s.prev.p, si.light) *
-                                     light.pdfLi(s.prev, s.ray.d, si.p, si.ng);
-                    s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
-                }
-            }
-        }
-
-        // Medium boundaries without a surface: continue the ray unchanged. At the depth
-        // limit, pbrt-v3 ends the path here (it tests maxdepth before it skips a boundary):
-        // path always (its shadow rays stop at boundaries too); volpath where the light
-        // beyond would count at full weight (the camera ray, after a specular bounce). After a
-        // non-specular vertex the ray goes on for its MIS-weighted share, which volpath's
-        // next-event estimation finds through boundaries (docs/MEDIA.md, "Depth limit
-        // at medium boundaries").
-        if (si.material < 0) {
-            const bool fullWeight = bounces == 0 || s.specularBounce;
-            if ((bounces >= maxDepth_ && (!media || fullWeight)) || ++passThroughs > 256) break;
-            {
+        for (int bounces = startBounces;; ++bounces) {
+            // The closest hit. The path's last direction (no vertex after it) brings back only
+            // the emission it hits, weighted against this vertex's next-event estimation: the
+            // learned Q, the light of whole returns, overstates what it can find there, and its
+            // truncated return would understate Q for the vertices before the last. It samples
+            // the BSDF and records no return (Eq. 1 targets, bootstrapped from Q, are learned
+            // there as everywhere), so a surface vertex looks up a region only before it or to
+            // bootstrap.
+            SurfaceInteraction si;
+            ++stats.rays;
+            const bool found = scene_.intersect(s.ray, &si);
+            const bool lastDirection = bounces + 1 >= maxDepth_;
+            const bool wantsRegion = field && (!lastDirection || rec.bootstraps());
+            // The lookup below reads a table entry for si.p: start loading it (a cache miss
+            // otherwise; the material evaluation runs in between).
+            guiding::VertexQuery query;
+            if (found && wantsRegion) {
                 GuideTimer timer(s.clock);
-                rec.passedThrough(emitted);
+                query.p = si.p;
+                if (guide_.patches) query.patch = guide_.patches->key(si);
+                field->prefetch(query);
             }
-            if (media) s.pm.medium = si.mediumAfter(s.ray.d, s.pm.medium);
-            s.ray.o = spawnOrigin(si, s.ray.d, originScale_);
-            --bounces;
-            continue;
-        }
-        if (bounces >= maxDepth_ && !rec.awaitsTarget()) break;
 
-        // The BSDF, and the guide here: its region, and the guide's probability (mix x the
-        // region's confidence x the BSDF's diffuse share).
-        bsdf.clear();
-        scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
-        const BSDF::LobeCounts lobes = bsdf.lobeCounts();
-        const bool canGuide = field && guidable(lobes);
-        guiding::VertexGuide guide;
-        if (canGuide && wantsRegion) {
-            GuideTimer timer(s.clock);
-            query.n = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
-            guide = field->guide(query);
-        }
-        countGuided(guide, s.clock, stats);
-        const bool lastVertex = bounces >= maxDepth_;
-        const float share =
-            guide.valid() && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
-        const guiding::VertexGuide sampleGuide = share > 0.f ? guide : guiding::VertexGuide();
-        GuideMixture vertexGuide{sampleGuide, share};
-        vertexGuide.clock = s.clock;
-
-        // Next-event estimation at non-specular vertices (first: its shadow ray gives the
-        // guide's prefetch of the region's tables time to land).
-        if (!lastVertex) {
-            ++stats.vertices;
-            if (lobes.smooth > 0)
-                s.L += s.beta * sampleLight(si, bsdf, vertexGuide, sampler, stats,
-                                            media ? &s.pm : nullptr);
-        }
-        // Training: the previous guided vertex's Eq. 1 target, from the light found here.
-        bool deferTarget;
-        {
-            GuideTimer timer(s.clock);
-            rec.arrived(si.p, s.L);
-            deferTarget =
-                rec.surfaceReached(si, bsdf, guide, canGuide, lobes.all, emitted, lastVertex);
-        }
-        if (lastVertex) break;
-
-        // Splitting: how many paths continue from here (r, rounded stochastically).
-        float splitRatio = 1.f;
-        int splitCount = 1, retBase = 0;
-        if (guide_.splitMax > 1 && sampleGuide.valid() && pixelEstimate > 0.f && !media &&
-            !bsdf.subsurface() && guideConfidence(vertexGuide) >= kRouletteConfidence) {
-            const float expected = luminance(s.beta) * luminance(bsdf.f(si.wo, query.n)) *
-                                   sampleGuide.irradianceEstimate(query.n);
-            const float r = expected / (guide_.splitWindow * pixelEstimate);
-            if (r > 1.f && std::isfinite(r)) {
-                // At most as many branches as the stack holds: E[count] = ratio exactly.
-                splitRatio = std::min({r, float(guide_.splitMax), float(1 + branchesLeft)});
-                splitCount = int(splitRatio);
-                if (sampler.get1D() < splitRatio - float(splitCount)) ++splitCount;
-                if (splitCount > 1) retBase = rec.split();
-                branchesLeft -= splitCount - 1;
+            // Media: a free flight to the hit; a scattering event is a medium vertex.
+            if (media && s.pm.medium >= 0) {
+                const Step step = mediumStep(s, found, si, bounces, sampler, stats, rec);
+                if (step == Step::End) break;
+                if (step == Step::Scattered) continue;
             }
-        }
-        for (int k = 1; k < splitCount; ++k) {
-            DirectionSample dk = sampleDirection(si, bsdf, vertexGuide, sampler);
-            if (!(dk.pdf > 0.f) || isBlack(dk.f)) continue;
-            Branch& b = branches[numBranches];
-            b.s = s;
-            b.s.beta *= dk.f * (std::abs(glm::dot(dk.wi, si.ns)) / (dk.pdf * splitRatio));
-            if (!isFinite(b.s.beta)) continue;
-            b.s.dirPdf = dk.pdf;
-            b.s.specularBounce = dk.specular;
-            if (dk.specular && dk.transmission) {
-                float eta = bsdf.eta();
-                b.s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
-            }
-            b.s.prev = LightSampleContext{si.p, si.ng};
-            b.s.ray.o = spawnOrigin(si, dk.wi, originScale_);
-            b.s.ray.d = dk.wi;
-            b.s.ray.tMax = Infinity;
-            b.bounces = bounces;
-            b.retBase = retBase;
-            b.guide = guide;
-            b.bin = dk.bin;
-            b.wi = dk.wi;
-            b.learnsReturn = !dk.transmission && !lastDirection;
-            ++numBranches;
-        }
 
-        // The next direction (the guiding seam), and what the guide learns from it.
-        DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
-
-        {
-            GuideTimer timer(s.clock);
-            rec.surfaceSampled(deferTarget, si, guide, ds, emitted);
-        }
-        if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
-        {
-            GuideTimer timer(s.clock);
-            rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
-        }
-        const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
-        s.beta *= weight;
-        if (splitRatio > 1.f) s.beta /= splitRatio;  // one of about r branches
-        s.dirPdf = ds.pdf;
-        s.specularBounce = ds.specular;
-        {
-            GuideTimer timer(s.clock);
-            rec.surfaceScattered(guide, !ds.transmission && !lastDirection, canGuide, ds, weight,
-                                 s.L, s.beta);
-        }
-
-        // The next ray.
-        if (ds.specular && ds.transmission) {
-            float eta = bsdf.eta();
-            s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
-        }
-        s.prev = LightSampleContext{si.p, si.ng};
-        if (media) s.pm.medium = si.mediumAfter(ds.wi, s.pm.medium);
-        s.ray.o = spawnOrigin(si, ds.wi, originScale_);
-        s.ray.d = ds.wi;
-        s.ray.tMax = Infinity;
-        if (!isFinite(s.beta)) break;
-        // A transmission into a material with a BSSRDF: the path continues from an exit point.
-        if (ds.transmission && bsdf.subsurface() &&
-            subsurfaceStep(s, si, bsdf, sampler, stats, rec) == Step::End)
-            break;
-
-        // Russian roulette: from the second vertex on, on the expected contribution where
-        // the guide knows it; else pbrt-v3's.
-        if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
-            sampleGuide.valid() && !ds.transmission &&
-            guideConfidence(vertexGuide) >= kRouletteConfidence) {
-            float expected;
-            {
+            // Emission reached by the previous scattering (or seen by the camera), weighted by
+            // MIS against next-event estimation.
+            if (!found) {
+                float envLum = 0.f;
+                for (int idx : scene_.infiniteLights) {
+                    const Light& light = *scene_.lights[size_t(idx)];
+                    Spectrum Le = light.Le(s.ray.d);
+                    if (isBlack(Le)) continue;
+                    envLum += luminance(Le);
+                    if (bounces == 0 || s.specularBounce) {
+                        s.L += s.beta * Le;
+                    } else {
+                        float lightPdf = lights_->pmf(s.prev.p, idx) *
+                                         light.pdfLi(s.prev, s.ray.d, Vec3(0.f), Vec3(0.f));
+                        s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
+                    }
+                }
                 GuideTimer timer(s.clock);
-                expected = luminance(s.beta) * sampleGuide.policyRadiance(ds.wi, ds.bin);
-            }
-            if (!adjointRoulette(&s.beta, expected, guide_.rouletteWindow * pixelEstimate,
-                                 kMinSurvival, sampler))
+                rec.escaped(envLum);
                 break;
-            continue;
+            }
+            float emitted = 0.f;
+            if (si.light >= 0) {
+                const Light& light = *scene_.lights[size_t(si.light)];
+                Spectrum Le = light.L(si.p, si.ng, si.uv, si.wo);
+                if (!isBlack(Le)) {
+                    emitted = luminance(Le);
+                    if (bounces == 0 || s.specularBounce) {
+                        s.L += s.beta * Le;
+                    } else {
+                        float lightPdf = lights_->pmf(s.prev.p, si.light) *
+                                         light.pdfLi(s.prev, s.ray.d, si.p, si.ng);
+                        s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
+                    }
+                }
+            }
+
+            // Medium boundaries without a surface: continue the ray unchanged. At the depth
+            // limit, pbrt-v3 ends the path here (it tests maxdepth before it skips a boundary):
+            // path always (its shadow rays stop at boundaries too); volpath where the light
+            // beyond would count at full weight (the camera ray, after a specular bounce). After a
+            // non-specular vertex the ray goes on for its MIS-weighted share, which volpath's
+            // next-event estimation finds through boundaries (docs/MEDIA.md, "Depth limit
+            // at medium boundaries").
+            if (si.material < 0) {
+                const bool fullWeight = bounces == 0 || s.specularBounce;
+                if ((bounces >= maxDepth_ && (!media || fullWeight)) || ++passThroughs > 256) break;
+                {
+                    GuideTimer timer(s.clock);
+                    rec.passedThrough(emitted);
+                }
+                if (media) s.pm.medium = si.mediumAfter(s.ray.d, s.pm.medium);
+                s.ray.o = spawnOrigin(si, s.ray.d, originScale_);
+                --bounces;
+                continue;
+            }
+            if (bounces >= maxDepth_ && !rec.awaitsTarget()) break;
+
+            // The BSDF, and the guide here: its region, and the guide's probability (mix x the
+            // region's confidence x the BSDF's diffuse share).
+            bsdf.clear();
+            scene_.materials[size_t(si.material)]->computeBSDF(si, sampler.get1D(), &bsdf);
+            const BSDF::LobeCounts lobes = bsdf.lobeCounts();
+            const bool canGuide = field && guidable(lobes);
+            guiding::VertexGuide guide;
+            if (canGuide && wantsRegion) {
+                GuideTimer timer(s.clock);
+                query.n = glm::dot(si.ns, si.wo) >= 0.f ? si.ns : -si.ns;
+                guide = field->guide(query);
+            }
+            countGuided(guide, s.clock, stats);
+            const bool lastVertex = bounces >= maxDepth_;
+            const float share =
+                guide.valid() && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
+            const guiding::VertexGuide sampleGuide = share > 0.f ? guide : guiding::VertexGuide();
+            GuideMixture vertexGuide{sampleGuide, share};
+            vertexGuide.clock = s.clock;
+
+            // Next-event estimation at non-specular vertices (first: its shadow ray gives the
+            // guide's prefetch of the region's tables time to land).
+            if (!lastVertex) {
+                ++stats.vertices;
+                if (lobes.smooth > 0)
+                    s.L += s.beta * sampleLight(si, bsdf, vertexGuide, sampler, stats,
+                                                media ? &s.pm : nullptr);
+            }
+            // Training: the previous guided vertex's Eq. 1 target, from the light found here.
+            bool deferTarget;
+            {
+                GuideTimer timer(s.clock);
+                rec.arrived(si.p, s.L);
+                deferTarget =
+                    rec.surfaceReached(si, bsdf, guide, canGuide, lobes.all, emitted, lastVertex);
+            }
+            if (lastVertex) break;
+
+            // Splitting: how many paths continue from here (r, rounded stochastically).
+            float splitRatio = 1.f;
+            int splitCount = 1, retBase = 0;
+            if (guide_.splitMax > 1 && sampleGuide.valid() && pixelEstimate > 0.f && !media &&
+                !bsdf.subsurface() && guideConfidence(vertexGuide) >= kRouletteConfidence) {
+                const float expected = luminance(s.beta) * luminance(bsdf.f(si.wo, query.n)) *
+                                       sampleGuide.irradianceEstimate(query.n);
+                const float r = expected / (guide_.splitWindow * pixelEstimate);
+                if (r > 1.f && std::isfinite(r)) {
+                    // At most as many branches as the stack holds: E[count] = ratio exactly.
+                    splitRatio = std::min({r, float(guide_.splitMax), float(1 + branchesLeft)});
+                    splitCount = int(splitRatio);
+                    if (sampler.get1D() < splitRatio - float(splitCount)) ++splitCount;
+                    if (splitCount > 1) retBase = rec.split();
+                    branchesLeft -= splitCount - 1;
+                }
+            }
+            for (int k = 1; k < splitCount; ++k) {
+                DirectionSample dk = sampleDirection(si, bsdf, vertexGuide, sampler);
+                if (!(dk.pdf > 0.f) || isBlack(dk.f)) continue;
+                Branch& b = branches[numBranches];
+                b.s = s;
+                b.s.beta *= dk.f * (std::abs(glm::dot(dk.wi, si.ns)) / (dk.pdf * splitRatio));
+                if (!isFinite(b.s.beta)) continue;
+                b.s.dirPdf = dk.pdf;
+                b.s.specularBounce = dk.specular;
+                if (dk.specular && dk.transmission) {
+                    float eta = bsdf.eta();
+                    b.s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
+                }
+                b.s.prev = LightSampleContext{si.p, si.ng};
+                b.s.ray.o = spawnOrigin(si, dk.wi, originScale_);
+                b.s.ray.d = dk.wi;
+                b.s.ray.tMax = Infinity;
+                b.bounces = bounces;
+                b.retBase = retBase;
+                b.guide = guide;
+                b.bin = dk.bin;
+                b.wi = dk.wi;
+                b.learnsReturn = !dk.transmission && !lastDirection;
+                ++numBranches;
+            }
+
+            // The next direction (the guiding seam), and what the guide learns from it.
+            DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
+
+            {
+                GuideTimer timer(s.clock);
+                rec.surfaceSampled(deferTarget, si, guide, ds, emitted);
+            }
+            if (!(ds.pdf > 0.f) || isBlack(ds.f)) break;
+            {
+                GuideTimer timer(s.clock);
+                rec.selectionVertex(sampleGuide, ds, s.L, s.beta);
+            }
+            const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
+            s.beta *= weight;
+            if (splitRatio > 1.f) s.beta /= splitRatio;  // one of about r branches
+            s.dirPdf = ds.pdf;
+            s.specularBounce = ds.specular;
+            {
+                GuideTimer timer(s.clock);
+                rec.surfaceScattered(guide, !ds.transmission && !lastDirection, canGuide, ds, weight,
+                                     s.L, s.beta);
+            }
+
+            // The next ray.
+            if (ds.specular && ds.transmission) {
+                float eta = bsdf.eta();
+                s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
+            }
+            s.prev = LightSampleContext{si.p, si.ng};
+            if (media) s.pm.medium = si.mediumAfter(ds.wi, s.pm.medium);
+            s.ray.o = spawnOrigin(si, ds.wi, originScale_);
+            s.ray.d = ds.wi;
+            s.ray.tMax = Infinity;
+            if (!isFinite(s.beta)) break;
+            // A transmission into a material with a BSSRDF: the path continues from an exit point.
+            if (ds.transmission && bsdf.subsurface() &&
+                subsurfaceStep(s, si, bsdf, sampler, stats, rec) == Step::End)
+                break;
+
+            // Russian roulette: from the second vertex on, on the expected contribution where
+            // the guide knows it; else pbrt-v3's.
+            if (guide_.adjointRoulette && bounces >= kRouletteFirstBounce && pixelEstimate > 0.f &&
+                sampleGuide.valid() && !ds.transmission &&
+                guideConfidence(vertexGuide) >= kRouletteConfidence) {
+                float expected;
+                {
+                    GuideTimer timer(s.clock);
+                    expected = luminance(s.beta) * sampleGuide.policyRadiance(ds.wi, ds.bin);
+                }
+                if (!adjointRoulette(&s.beta, expected, guide_.rouletteWindow * pixelEstimate,
+                                     kMinSurvival, sampler))
+                    break;
+                continue;
+            }
+            if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) break;
         }
-        if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) break;
-    }
-    if (numBranches == 0) break;
-    {
-        GuideTimer timer(s.clock);
-        rec.segmentEnded(s.L, branches[numBranches - 1].retBase);
-    }
-    // The next branch, with the light of every branch so far.
-    const Spectrum L = s.L;
-    --numBranches;
-    const Branch& b = branches[numBranches];
-    s = b.s;
-    s.L = L;
-    startBounces = b.bounces + 1;
-    {
-        GuideTimer timer(s.clock);
-        rec.branchStarted(b.guide, b.learnsReturn, b.bin, b.wi, s.L, s.beta);
-    }
+        if (numBranches == 0) break;
+        {
+            GuideTimer timer(s.clock);
+            rec.segmentEnded(s.L, branches[numBranches - 1].retBase);
+        }
+        // The next branch, with the light of every branch so far.
+        const Spectrum L = s.L;
+        --numBranches;
+        const Branch& b = branches[numBranches];
+        s = b.s;
+        s.L = L;
+        startBounces = b.bounces + 1;
+        {
+            GuideTimer timer(s.clock);
+            rec.branchStarted(b.guide, b.learnsReturn, b.bin, b.wi, s.L, s.beta);
+        }
     }
     {
         GuideTimer timer(s.clock);

@@ -110,6 +110,15 @@ chi2::SphereResult sphereAt(const GuidingField& f, int region, const glm::vec3& 
         [&](const glm::vec3& w) { return f.pdfAt(region, x, w); }, opt);
 }
 
+TEST(HemiSpots, RefusedWithTreeDirections) {
+    GuideConfig cfg;
+    cfg.backend = "hemi";
+    cfg.params = {{"spots", "2"}, {"directions", "tree"}};
+    std::string error;
+    EXPECT_FALSE(createGuidingField(cfg, planeScene(), &error));
+    EXPECT_NE(error.find("directions=strata"), std::string::npos) << error;
+}
+
 TEST(HemiSpots, UntrainedFieldIsTheStrata) {
     auto f = makeHemi({{"points", "16"}, {"spots", "4"}, {"warmup", "0"}});
     ASSERT_TRUE(f);
