@@ -130,6 +130,16 @@ std::vector<RecordingField::Record> train(const Scene& scene, bool pathTarget,
     return field.records;
 }
 
+// What direction w of the plane's vertex brings back from the sky as the estimator counts
+// it: the sky's luminance, MIS-weighted against next-event estimation with the direction's
+// mixture pdf (half the guide's uniform hemisphere, half Lambertian).
+float skyReturn(const Light& sky, const glm::vec3& w) {
+    const float dirPdf = 0.5f / (2.f * Pi) + 0.5f * w.z / Pi;
+    const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
+    const float lightPdf = sky.pdfLi(ctx, w, Vec3(0.f), Vec3(0.f));
+    return luminance(Spectrum(1.f)) * powerHeuristic(1, dirPdf, 1, lightPdf);
+}
+
 TEST(GuideTargets, PathTargetIsTheMisWeightedReturnOfTheDirection) {
     auto scene = buildPlane();
     ASSERT_TRUE(scene);
@@ -144,11 +154,7 @@ TEST(GuideTargets, PathTargetIsTheMisWeightedReturnOfTheDirection) {
         // Guided or drawn from the BSDF, the direction's bin found by sample() or pdf() comes
         // back with its record (the field need not find it again).
         EXPECT_EQ(r.bin, RecordingField::binOf(r.w)) << r.w.z;
-        // The direction's mixture pdf: half the guide's uniform hemisphere, half Lambertian.
-        const float dirPdf = 0.5f / (2.f * Pi) + 0.5f * r.w.z / Pi;
-        const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
-        const float lightPdf = sky.pdfLi(ctx, r.w, Vec3(0.f), Vec3(0.f));
-        const float expected = lumSky * powerHeuristic(1, dirPdf, 1, lightPdf);
+        const float expected = skyReturn(sky, r.w);
         EXPECT_NEAR(r.target, expected, 2e-3f * expected + 1e-6f) << r.w.z;
         meanTarget += r.target;
     }
@@ -173,10 +179,7 @@ TEST(GuideTargets, EveryBranchOfASplitPathLearnsItsOwnReturn) {
     for (const auto& r : records) {
         ASSERT_GT(r.w.z, 0.f);
         EXPECT_EQ(r.bin, RecordingField::binOf(r.w)) << r.w.z;
-        const float dirPdf = 0.5f / (2.f * Pi) + 0.5f * r.w.z / Pi;
-        const LightSampleContext ctx{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
-        const float lightPdf = sky.pdfLi(ctx, r.w, Vec3(0.f), Vec3(0.f));
-        const float expected = luminance(Spectrum(1.f)) * powerHeuristic(1, dirPdf, 1, lightPdf);
+        const float expected = skyReturn(sky, r.w);
         EXPECT_NEAR(r.target, expected, 2e-3f * expected + 1e-6f) << r.w.z;
     }
 }
