@@ -322,7 +322,7 @@ glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float
 
 void HemiField::recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
                            const glm::vec3& hit, float light, int bin) {
-    if (!spots_ || !validRegion(region) || trees_) return;
+    if (!spots_ || !validRegion(region)) return;  // (spots exclude directions=tree)
     // Only where the strata have learned enough to tell a spot from their estimate.
     if (frames_[size_t(region)].confidence < 0.5f) return;
     const int j = stratumOf(region, w, bin >= 0 ? bin & ~kSpotBin : bin);
@@ -569,15 +569,14 @@ GuidingStats HemiField::stats() const {
     return s;
 }
 
+bool HemiField::refusesSaving(const char* action, std::string* error) const {
+    const char* feature = trees_ ? "directions=tree" : spots_ ? "spots" : nullptr;
+    if (feature) *error = std::string("hemi with ") + feature + " " + action;
+    return feature != nullptr;
+}
+
 bool HemiField::save(const std::string& path, std::string* error) const {
-    if (trees_) {
-        *error = "hemi with directions=tree cannot be saved yet";
-        return false;
-    }
-    if (spots_) {
-        *error = "hemi with spots cannot be saved yet";
-        return false;
-    }
+    if (refusesSaving("cannot be saved yet", error)) return false;
     return fieldio::writeFile(path, serialize(), error);
 }
 
@@ -677,14 +676,7 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
 }
 
 bool HemiField::saveState(std::string* state, std::string* error) const {
-    if (trees_) {
-        *error = "hemi with directions=tree cannot save its learning state yet";
-        return false;
-    }
-    if (spots_) {
-        *error = "hemi with spots cannot save its learning state yet";
-        return false;
-    }
+    if (refusesSaving("cannot save its learning state yet", error)) return false;
     fieldio::Writer w;
     w.blob(serialize());
     table_.selection().saveState(w);
@@ -693,14 +685,7 @@ bool HemiField::saveState(std::string* state, std::string* error) const {
 }
 
 bool HemiField::loadState(const std::string& state, std::string* error) {
-    if (trees_) {
-        *error = "hemi with directions=tree cannot restore a learning state yet";
-        return false;
-    }
-    if (spots_) {
-        *error = "hemi with spots cannot restore a learning state yet";
-        return false;
-    }
+    if (refusesSaving("cannot restore a learning state yet", error)) return false;
     fieldio::Reader r(state);
     const std::string tables = r.blob();
     if (!r.ok()) {

@@ -208,6 +208,9 @@ private:
     // The saved field's bytes (save() writes them to a file), and their loading (`name`
     // names them in messages).
     std::string serialize() const;
+    // Whether the field holds what its files cannot (directions=tree, spots); then *error
+    // says "hemi with FEATURE ACTION".
+    bool refusesSaving(const char* action, std::string* error) const;
     bool loadBytes(const std::string& data, const std::string& name, std::string* error);
     // The CDF of one region from its Q (with the cosine product when params_.cosine).
     void buildPolicy(const double* q, float* cdf) const;

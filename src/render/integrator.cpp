@@ -240,6 +240,21 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
     return ds;
 }
 
+void PathIntegrator::takeDirection(PathState& s, const SurfaceInteraction& si, const BSDF& bsdf,
+                                   const DirectionSample& ds, bool media) const {
+    s.dirPdf = ds.pdf;
+    s.specularBounce = ds.specular;
+    if (ds.specular && ds.transmission) {
+        float eta = bsdf.eta();
+        s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
+    }
+    s.prev = LightSampleContext{si.p, si.ng};
+    if (media) s.pm.medium = si.mediumAfter(ds.wi, s.pm.medium);
+    s.ray.o = spawnOrigin(si, ds.wi, originScale_);
+    s.ray.d = ds.wi;
+    s.ray.tMax = Infinity;
+}
+
 Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf,
                                      GuideMixture& guide, Sampler& sampler, PathStats& stats,
                                      const PathMedium* media) const {
@@ -646,16 +661,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 b.s = s;
                 b.s.beta *= dk.f * (std::abs(glm::dot(dk.wi, si.ns)) / (dk.pdf * splitRatio));
                 if (!isFinite(b.s.beta)) continue;
-                b.s.dirPdf = dk.pdf;
-                b.s.specularBounce = dk.specular;
-                if (dk.specular && dk.transmission) {
-                    float eta = bsdf.eta();
-                    b.s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
-                }
-                b.s.prev = LightSampleContext{si.p, si.ng};
-                b.s.ray.o = spawnOrigin(si, dk.wi, originScale_);
-                b.s.ray.d = dk.wi;
-                b.s.ray.tMax = Infinity;
+                takeDirection(b.s, si, bsdf, dk, false);
                 b.bounces = bounces;
                 b.retBase = retBase;
                 b.guide = guide;
@@ -680,24 +686,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             const Spectrum weight = ds.f * std::abs(glm::dot(ds.wi, si.ns)) / ds.pdf;
             s.beta *= weight;
             if (splitRatio > 1.f) s.beta /= splitRatio;  // one of about r branches
-            s.dirPdf = ds.pdf;
-            s.specularBounce = ds.specular;
             {
                 GuideTimer timer(s.clock);
                 rec.surfaceScattered(guide, !ds.transmission && !lastDirection, canGuide, ds, weight,
                                      s.L, s.beta);
             }
-
             // The next ray.
-            if (ds.specular && ds.transmission) {
-                float eta = bsdf.eta();
-                s.etaScale *= glm::dot(si.wo, si.ng) > 0.f ? eta * eta : 1.f / (eta * eta);
-            }
-            s.prev = LightSampleContext{si.p, si.ng};
-            if (media) s.pm.medium = si.mediumAfter(ds.wi, s.pm.medium);
-            s.ray.o = spawnOrigin(si, ds.wi, originScale_);
-            s.ray.d = ds.wi;
-            s.ray.tMax = Infinity;
+            takeDirection(s, si, bsdf, ds, media);
             if (!isFinite(s.beta)) break;
             // A transmission into a material with a BSSRDF: the path continues from an exit point.
             if (ds.transmission && bsdf.subsurface() &&

@@ -232,6 +232,11 @@ private:
     // direction sampling, roulette). Surface: the flight reached the surface (or escaped);
     // Scattered: s.ray is the next ray; End: the path ends.
     enum class Step { Surface, Scattered, End };
+    // Continues s from surface vertex si along the sampled direction ds (its throughput
+    // weight is the caller's): the next ray, and what MIS, the roulette and media remember
+    // of the vertex (the medium only if `media`). The path and its split branches share it.
+    void takeDirection(PathState& s, const SurfaceInteraction& si, const BSDF& bsdf,
+                       const DirectionSample& ds, bool media) const;
     Step mediumStep(PathState& s, bool found, const SurfaceInteraction& si, int bounces,
                     Sampler& sampler, PathStats& stats, PathRecorder& rec) const;
     // The subsurface step of Li (pbrt-v3's BSSRDF sampling), after the BSDF of a material with
