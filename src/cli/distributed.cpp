@@ -6,6 +6,8 @@
 #include <chrono>
 #include <climits>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace rlpbrt {
@@ -103,6 +105,30 @@ public:
         for (size_t off = 0; off < n; off += kChunk)
             MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : data + off, rank_ == 0 ? data + off : nullptr,
                        int(std::min(kChunk, n - off)), MPI_FLOAT, MPI_SUM, 0, MPI_COMM_WORLD);
+    }
+
+    void gatherBytes(std::string& data) override {
+        Timed t(&seconds_);
+        arrive();
+        bytes_ += data.size();
+        // Each rank's length, then the bytes (a rank's share must stay below 2 GiB, and so
+        // must the whole: the spot candidates of one pass are far less).
+        const long long mine = (long long)data.size();
+        std::vector<long long> lengths(size_t(size_), 0);
+        MPI_Allgather(&mine, 1, MPI_LONG_LONG, lengths.data(), 1, MPI_LONG_LONG, MPI_COMM_WORLD);
+        std::vector<int> counts(static_cast<size_t>(size_), 0), offsets(static_cast<size_t>(size_), 0);
+        long long total = 0;
+        for (int k = 0; k < size_; ++k) {
+            if (lengths[size_t(k)] > INT_MAX || total > INT_MAX - lengths[size_t(k)])
+                throw std::runtime_error("gatherBytes: more than 2 GiB");
+            counts[size_t(k)] = int(lengths[size_t(k)]);
+            offsets[size_t(k)] = int(total);
+            total += lengths[size_t(k)];
+        }
+        std::string all(size_t(total), '\0');
+        MPI_Allgatherv(data.data(), int(mine), MPI_BYTE, all.data(), counts.data(),
+                       offsets.data(), MPI_BYTE, MPI_COMM_WORLD);
+        data = std::move(all);
     }
 
     void broadcast(void* data, size_t bytes) override {

@@ -78,6 +78,9 @@ struct SumAcrossProcesses {
     // half the bytes of doubles).
     std::function<void(std::vector<uint32_t>&)> counts;
     double countLimit = 4294967296.0;  // 2^32
+    // Bytes: every process's, concatenated in process order, in every process's string (the
+    // spot lobes' candidates, whose number differs between processes).
+    std::function<void(std::string&)> gather;
     void operator()(std::vector<double>& v) const { doubles(v); }
     // Sums counts whose totals over the processes are at most `bound`: through `counts` when
     // bound < countLimit, else as doubles (exact below 2^53).

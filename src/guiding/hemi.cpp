@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "guiding/field_io.h"
 
@@ -458,17 +459,17 @@ void HemiField::buildPolicy(const double* q, float* cdf) const {
     buildStrataCdf(qc, strata_, params_.epsilon, cdf);
 }
 
+double HemiField::learnedTotal(size_t region) const {
+    const double* q = table_.q(region);
+    const uint64_t* v = table_.visits(region);
+    double total = 0.0;
+    for (int j = 0; j < strata_; ++j) total += q[j] * double(v[j]);
+    return total;
+}
+
 void HemiField::endPass() {
     table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
-    if (spots_) {
-        spots_->endPass([this](size_t r) {
-            const double* q = table_.q(r);
-            const uint64_t* v = table_.visits(r);
-            double total = 0.0;
-            for (int j = 0; j < strata_; ++j) total += q[j] * double(v[j]);
-            return total;
-        });
-    }
+    if (spots_) spots_->endPass([this](size_t r) { return learnedTotal(r); });
     if (trees_) {
         trees_->endPass();
         updateTreeRegions();
@@ -497,6 +498,14 @@ void HemiField::updateTreeRegions() {
 
 void HemiField::endPassShared(const SumAcrossProcesses& sum) {
     table_.endPassShared(params_.alphaVisits, params_.fixedAlpha, policy(), sum);
+    if (spots_) {
+        // Every rank's candidates, merged in slot order on each (SpotLobes::takeCandidates).
+        std::string candidates = spots_->takeCandidates();
+        sum.gather(candidates);
+        if (!spots_->putCandidates(candidates))
+            throw std::runtime_error("hemi: the ranks' spot candidates are corrupt");
+        spots_->endPass([this](size_t r) { return learnedTotal(r); });
+    }
 }
 
 size_t HemiField::bytes() const {
@@ -570,7 +579,7 @@ GuidingStats HemiField::stats() const {
 }
 
 bool HemiField::refusesSaving(const char* action, std::string* error) const {
-    const char* feature = trees_ ? "directions=tree" : spots_ ? "spots" : nullptr;
+    const char* feature = trees_ ? "directions=tree" : nullptr;
     if (feature) *error = std::string("hemi with ") + feature + " " + action;
     return feature != nullptr;
 }
@@ -603,6 +612,11 @@ std::string HemiField::serialize() const {
     w.data.reserve(w.data.size() + q.size() * 16);
     for (double d : q) w.f64(d);
     for (uint64_t v : visits) w.u64(v);
+    // The spot lobes (docs/GUIDE_FILES.md: an optional section after the tables).
+    if (spots_) {
+        w.u32(kSpotsSection);
+        w.blob(spots_->write());
+    }
     return std::move(w.data);
 }
 
@@ -661,7 +675,7 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
                     ", this field has " + std::to_string(params_.cols) + "x" +
                     std::to_string(params_.rows));
     const size_t count = size_t(numRegions()) * size_t(strata_);
-    if (r.remaining() != count * 16) return fail("table size does not match the header");
+    if (r.remaining() < count * 16) return fail("table size does not match the header");
     std::vector<double> q(count);
     std::vector<uint64_t> visits(count);
     for (double& d : q) {
@@ -670,8 +684,22 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
     }
     for (uint64_t& v : visits) v = r.u64();
     if (!r.ok()) return fail("truncated tables");
+    // The spot lobes, if saved: a field without spots uses the strata alone; one with spots
+    // loading a field saved without them starts its lobes empty.
+    std::string lobes;
+    if (r.remaining() > 0) {
+        if (r.u32() != kSpotsSection) return fail("unknown data after the tables");
+        lobes = r.blob();
+        if (!r.ok() || r.remaining() != 0) return fail("truncated spot lobes");
+    }
+    if (spots_) {
+        std::string why;
+        if (!lobes.empty() && !spots_->read(lobes, &why)) return fail(why);
+        if (lobes.empty()) spots_->reset(spots_->regions(), spots_->settings());
+    }
     table_.assign(std::move(q), std::move(visits), policy());
     table_.stats() = s;
+    if (spots_) spots_->refitAll([this](size_t reg) { return learnedTotal(reg); });
     return true;
 }
 

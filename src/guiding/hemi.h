@@ -143,7 +143,7 @@ public:
     void endPass() override;
     void endPassShared(const SumAcrossProcesses& sum) override;
     // Not with directions=tree: its adaptive trees are not shared yet.
-    bool sharesPasses() const override { return !trees_ && !spots_; }
+    bool sharesPasses() const override { return !trees_; }
     size_t bytes() const override;
     std::string describe() const override;
     GuidingStats stats() const override;
@@ -238,6 +238,8 @@ private:
     // A bin flag: the direction was drawn from the spot lobes (sampleAt); bins with it are
     // out of the strata's range, so radiance() and policyRadiance() find the stratum again.
     static constexpr int kSpotBin = 1 << 24;
+    // The tag of a saved field's spot-lobe section.
+    static constexpr uint32_t kSpotsSection = 0x53504f54;  // "SPOT"
 
     HemiParams params_;
     StrataLayout layout_;
@@ -300,6 +302,9 @@ private:
     }
     // After the trees' endPass: every learned region's moment and confidence.
     void updateTreeRegions();
+    // The sum of every target a region has learned (its strata's Q x visits): the spot
+    // lobes' share is set against it.
+    double learnedTotal(size_t region) const;
     uint64_t attempts_ = 0;  // samplePoint calls made at construction
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "guiding/field_io.h"
 #include "util/math.h"
 
 namespace rlpbrt::guiding {
@@ -194,6 +195,112 @@ void SpotLobes::refit(size_t region, double regionTotal) {
     }
     const double share = regionTotal > 0.0 ? active / regionTotal : settings_.maxShare;
     share_[region] = float(std::clamp(share, kMinShare, settings_.maxShare));
+}
+
+std::string SpotLobes::takeCandidates() {
+    fieldio::Writer w;
+    for (size_t slot = 0; slot < slots_.size(); ++slot) {
+        for (const Candidate& c : slots_[slot]) {
+            w.u32(uint32_t(slot));
+            w.u32(c.region);
+            w.vec3(c.x);
+            w.vec3(c.w);
+            w.vec3(c.hit);
+            w.f32(c.light);
+        }
+        slots_[slot].clear();
+    }
+    return std::move(w.data);
+}
+
+bool SpotLobes::putCandidates(const std::string& bytes) {
+    constexpr size_t kBytes = 4 + 4 + 10 * 4;
+    if (bytes.size() % kBytes != 0) return false;
+    // Checked whole before anything is added.
+    std::vector<std::pair<uint32_t, Candidate>> all(bytes.size() / kBytes);
+    fieldio::Reader r(bytes);
+    for (auto& [slot, c] : all) {
+        slot = r.u32();
+        c.region = r.u32();
+        c.x = r.vec3();
+        c.w = r.vec3();
+        c.hit = r.vec3();
+        c.light = r.f32();
+        if (slot > (1u << 20) || c.region >= share_.size()) return false;
+    }
+    if (!r.ok()) return false;
+    for (auto& [slot, c] : all) {
+        if (slot >= slots_.size()) slots_.resize(size_t(slot) + 1);
+        slots_[slot].push_back(c);
+    }
+    return true;
+}
+
+std::string SpotLobes::write() const {
+    fieldio::Writer w;
+    w.u32(uint32_t(settings_.perRegion));
+    w.u64(uint64_t(lobeCount_.size()));
+    for (size_t r = 0; r < lobeCount_.size(); ++r) {
+        w.u32(lobeCount_[r]);
+        const Lobe* l = &lobes_[r * size_t(settings_.perRegion)];
+        for (int i = 0; i < lobeCount_[r]; ++i) {
+            w.vec3(l[i].point);
+            w.vec3(l[i].dir);
+            w.f32(l[i].kappa);
+            w.f64(l[i].sumLight);
+            for (int k = 0; k < 3; ++k) w.f64(l[i].sumPoint[k]);
+            for (int k = 0; k < 3; ++k) w.f64(l[i].sumDir[k]);
+            w.f64(l[i].sumErrPoint);
+            w.f64(l[i].sumErrDir);
+            w.u32(l[i].hits);
+        }
+    }
+    return std::move(w.data);
+}
+
+bool SpotLobes::read(const std::string& bytes, std::string* why) {
+    const size_t regions = lobeCount_.size();
+    reset(regions, settings_);
+    auto fail = [&](const std::string& what) {
+        reset(regions, settings_);
+        *why = what;
+        return false;
+    };
+    fieldio::Reader r(bytes);
+    const uint32_t perRegion = r.u32();
+    const uint64_t savedRegions = r.u64();
+    if (!r.ok()) return fail("truncated spot lobes");
+    if (perRegion != uint32_t(settings_.perRegion))
+        return fail("made with spots=" + std::to_string(perRegion) + ", this field has spots=" +
+                    std::to_string(settings_.perRegion));
+    if (savedRegions != regions) return fail("spot lobes of another number of regions");
+    for (size_t reg = 0; reg < regions; ++reg) {
+        const uint32_t n = r.u32();
+        if (!r.ok() || n > perRegion) return fail("corrupt spot lobes");
+        Lobe* l = &lobes_[reg * size_t(perRegion)];
+        for (uint32_t i = 0; i < n; ++i) {
+            l[i].point = r.vec3();
+            l[i].dir = r.vec3();
+            l[i].kappa = r.f32();
+            l[i].sumLight = r.f64();
+            for (int k = 0; k < 3; ++k) l[i].sumPoint[k] = r.f64();
+            for (int k = 0; k < 3; ++k) l[i].sumDir[k] = r.f64();
+            l[i].sumErrPoint = r.f64();
+            l[i].sumErrDir = r.f64();
+            l[i].hits = r.u32();
+            const double sums = l[i].sumLight + l[i].sumPoint.x + l[i].sumPoint.y +
+                                l[i].sumPoint.z + l[i].sumDir.x + l[i].sumDir.y + l[i].sumDir.z +
+                                l[i].sumErrPoint + l[i].sumErrDir;
+            if (!r.ok() || !std::isfinite(sums) || !(l[i].sumLight >= 0.0) ||
+                !(l[i].kappa >= 0.f) || !std::isfinite(l[i].kappa) ||
+                !std::isfinite(l[i].point.x + l[i].point.y + l[i].point.z + l[i].dir.x +
+                               l[i].dir.y + l[i].dir.z))
+                return fail("corrupt spot lobes");
+        }
+        lobeCount_[reg] = uint8_t(n);
+    }
+    if (r.remaining() != 0) return fail("corrupt spot lobes");
+    return true;
 }
 
 size_t SpotLobes::bytes() const {

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -32,6 +33,7 @@ class SpotLobes {
 public:
     void reset(size_t regions, const SpotSettings& settings);
     size_t regions() const { return share_.size(); }
+    const SpotSettings& settings() const { return settings_; }
 
     // The probability of sampling the lobes at a region (0: none there). Frozen per pass.
     float share(int region) const {
@@ -62,9 +64,31 @@ public:
     template <class Total>
     void endPass(Total&& regionTotal) {
         mergeCandidates();
+        refitAll(regionTotal);
+    }
+    // Refits every region's lobes from what they have learned (endPass's second half; after
+    // read()).
+    template <class Total>
+    void refitAll(Total&& regionTotal) {
         for (size_t r = 0; r < share_.size(); ++r)
             if (lobeCount_[r] > 0) refit(r, regionTotal(r));
     }
+
+    // Several processes learning one set of lobes (GuidingField::endPassShared): each takes
+    // its pass's candidates as bytes (the slots emptied), the processes concatenate their
+    // bytes in process order, and each puts the whole back before endPass. A slot's
+    // candidates stay in their order, and endPass merges the slots in slot order: where each
+    // slot is recorded by one process (a tile is one rank's), the lobes are those of one
+    // process that recorded every slot.
+    std::string takeCandidates();
+    // False (nothing added) if the bytes are not takeCandidates' of this configuration.
+    bool putCandidates(const std::string& bytes);
+
+    // The lobes' learned state (their accumulators and last fits) as bytes, and its restoring
+    // (then refitAll). read() fails, with *why, on bytes of another number of regions or
+    // lobes per region, or corrupt ones, and then leaves the lobes empty.
+    std::string write() const;
+    bool read(const std::string& bytes, std::string* why);
 
     size_t bytes() const;
     // Regions with at least one active lobe, and active lobes in all.

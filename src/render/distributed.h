@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 namespace rlpbrt {
 
@@ -28,6 +29,9 @@ public:
     // owner's bits. everyone: the result on every rank, else on rank 0 only (the others'
     // buffers are then unspecified).
     virtual void sumDisjointFloats(float* data, size_t n, bool everyone) = 0;
+    // Every rank's bytes, concatenated in rank order, in every rank's `data` (the ranks'
+    // strings may differ in length).
+    virtual void gatherBytes(std::string& data) = 0;
     // Rank 0's `bytes` bytes at `data` on every rank.
     virtual void broadcast(void* data, size_t bytes) = 0;
     // True on every rank if `ok` is true on every rank (all ranks must call it: an error on

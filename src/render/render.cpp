@@ -173,7 +173,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // The guide's pass statistics: summed over the ranks, the same on every rank.
     const guiding::SumAcrossProcesses sumAcross{
         [ranks](std::vector<double>& v) { ranks->sumDoubles(v.data(), v.size()); },
-        [ranks](std::vector<uint32_t>& v) { ranks->sumCounts(v.data(), v.size()); }};
+        [ranks](std::vector<uint32_t>& v) { ranks->sumCounts(v.data(), v.size()); },
+        guiding::SumAcrossProcesses().countLimit,
+        [ranks](std::string& bytes) { ranks->gatherBytes(bytes); }};
 
     double start = now();
     long long samplesDone = 0;

@@ -1,8 +1,9 @@
 // GuidingField::endPassShared, the guide's side of a distributed render (docs/DISTRIBUTED.md):
 // K fields that each record the slots of their own "rank" and end their passes through a
 // sum over the K of them (threads standing in for processes) learn the field of one process
-// that recorded every slot and ended its passes with endPass(). hemi and vdb (surface and
-// medium tables, voxel activation), with learned selections and rejected targets.
+// that recorded every slot and ended its passes with endPass(). hemi (with and without spot
+// lobes) and vdb (surface and medium tables, voxel activation), with learned selections and
+// rejected targets.
 #include "guiding/guiding.h"
 #include "guiding/hemi.h"
 #include "guiding/vdb.h"
@@ -14,6 +15,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -57,6 +59,36 @@ private:
     std::condition_variable cv_;
 };
 
+// SumAcrossProcesses::gather for K threads: every thread's bytes in rank order.
+class ThreadGather {
+public:
+    explicit ThreadGather(int k) : k_(k), strings_(size_t(k), nullptr) {}
+    void gather(int rank, std::string& bytes) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        strings_[size_t(rank)] = &bytes;
+        const long generation = generation_;
+        if (++arrived_ < k_) {
+            cv_.wait(lock, [&] { return generation_ != generation; });
+            return;
+        }
+        std::string all;
+        for (std::string* b : strings_) all += *b;
+        for (std::string* b : strings_) *b = all;
+        ++calls_;
+        arrived_ = 0;
+        ++generation_;
+        cv_.notify_all();
+    }
+    int calls() const { return calls_; }
+
+private:
+    int k_, arrived_ = 0, calls_ = 0;
+    long generation_ = 0;
+    std::vector<std::string*> strings_;
+    std::mutex mutex_;
+    std::condition_variable cv_;
+};
+
 constexpr int kSlots = 7;
 
 // A unit square floor with a box of fog above it (the vdb backend's medium tables).
@@ -91,6 +123,10 @@ void recordSlot(GuidingField& f, int pass, int s) {
             // (a few regions, so that they reach the learner's minimum of samples)
             const glm::vec3 hub(i % 3 == 0 ? 0.2f : 0.7f, 0.5f, 0.f);
             f.recordSelection(s, f.lookup(hub, n), x);
+            // Bright light from two small spots (hemi's spot lobes; others ignore it).
+            const glm::vec3 spot = i % 2 ? glm::vec3(0.3f, 0.8f, 2.f) : glm::vec3(-1.f, 0.2f, 1.5f);
+            const glm::vec3 hit = spot + 0.01f * glm::vec3(u(rng), u(rng), u(rng));
+            f.recordSpot(s, region, p, glm::normalize(hit - p), hit, 1e4f + target());
         }
         const glm::vec3 q(u(rng), u(rng), 0.5f * u(rng));
         const int cell = f.lookupMedium(q);
@@ -120,6 +156,14 @@ void expectSameField(const GuidingField& a, const GuidingField& b, int regions) 
         mismatches += a.selection(r) != b.selection(r);
         for (const glm::vec3& w : dirs) {
             mismatches += a.pdf(r, w) != b.pdf(r, w);
+            mismatches += a.pdfAt(r, glm::vec3(0.5f, 0.4f, 0.f), w) !=
+                          b.pdfAt(r, glm::vec3(0.5f, 0.4f, 0.f), w);
+            // (a small uStratum: hemi's spot lobes where a region has them)
+            const glm::vec2 u(0.5f + 0.4f * w.x, 0.5f + 0.4f * w.y);
+            float pa = 0.f, pb = 0.f;
+            const glm::vec3 x(0.5f, 0.4f, 0.f);
+            mismatches += a.sampleAt(r, x, u, 0.02f, &pa) != b.sampleAt(r, x, u, 0.02f, &pb);
+            mismatches += pa != pb;
             mismatches += a.radiance(r, w) != b.radiance(r, w);
         }
     }
@@ -130,7 +174,8 @@ void expectSameField(const GuidingField& a, const GuidingField& b, int regions) 
 template <class Field>
 void checkShared(const char* backend, const SceneInfo& scene,
                  std::map<std::string, std::string> params,
-                 const std::function<int(const Field&)>& regions, bool narrowCounts = true) {
+                 const std::function<int(const Field&)>& regions, bool narrowCounts = true,
+                 const std::function<void(const Field&)>& checkOne = nullptr) {
     constexpr int kRanks = 3, kPasses = 3;
     auto one = test::makeField<Field>(backend, scene, params);
     std::vector<std::unique_ptr<Field>> ranks;
@@ -139,6 +184,7 @@ void checkShared(const char* backend, const SceneInfo& scene,
     ASSERT_TRUE(one);
     ThreadSum<double> sum(kRanks);
     ThreadSum<uint32_t> counts(kRanks);
+    ThreadGather gather(kRanks);
     for (int pass = 0; pass < kPasses; ++pass) {
         one->beginPass(kSlots);
         for (int s = 0; s < kSlots; ++s) recordSlot(*one, pass, s);
@@ -149,8 +195,10 @@ void checkShared(const char* backend, const SceneInfo& scene,
                 Field& f = *ranks[size_t(k)];
                 f.beginPass(kSlots);
                 for (int s = k; s < kSlots; s += kRanks) recordSlot(f, pass, s);
-                SumAcrossProcesses across{[&](std::vector<double>& v) { sum.sum(k, v); },
-                                          [&](std::vector<uint32_t>& v) { counts.sum(k, v); }};
+                SumAcrossProcesses across;
+                across.doubles = [&](std::vector<double>& v) { sum.sum(k, v); };
+                across.counts = [&](std::vector<uint32_t>& v) { counts.sum(k, v); };
+                across.gather = [&](std::string& b) { gather.gather(k, b); };
                 if (!narrowCounts) across.countLimit = 0.0;
                 f.endPassShared(across);
             });
@@ -160,6 +208,7 @@ void checkShared(const char* backend, const SceneInfo& scene,
     EXPECT_GT(one->stats().rejectedTargets, 0u);
     EXPECT_GT(one->stats().selectionRegions, 0u);
     EXPECT_GE(sum.calls(), 2 * kPasses);
+    if (checkOne) checkOne(*one);
     if (narrowCounts) {
         EXPECT_GE(counts.calls(), 2 * kPasses);
     } else {
@@ -174,6 +223,14 @@ void checkShared(const char* backend, const SceneInfo& scene,
 TEST(SharedPass, HemiRanksLearnTheFieldOfOneProcess) {
     checkShared<HemiField>("hemi", test::cornerScene(), {{"mix", "learn"}},
                            [](const HemiField& f) { return f.numRegions(); });
+}
+
+TEST(SharedPass, HemiRanksLearnTheSpotLobesOfOneProcess) {
+    checkShared<HemiField>(
+        "hemi", test::cornerScene(), {{"mix", "learn"}, {"spots", "4"}, {"warmup", "0"}, {"points", "64"}},
+        [](const HemiField& f) { return f.numRegions(); }, true, [](const HemiField& f) {
+            EXPECT_GT(f.spots()->activeLobes(), 1u);
+        });
 }
 
 TEST(SharedPass, CountsAsDoublesGiveTheSameField) {

@@ -1,12 +1,14 @@
 // Tests of the spot lobes (guiding/spots.h) and of hemi's mixture of strata and lobes
 // (spots=N): the von Mises-Fisher lobe's sampling against its pdf (chi-square) and its unit
 // integral, a trained field's sampleAt against pdfAt over the sphere, trained and untrained,
-// and the lobes' samples kept out of the strata's means.
+// the lobes' samples kept out of the strata's means, and the lobes saved and restored
+// (--guide-save, checkpoints).
 #include "guiding/spots.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -185,6 +187,100 @@ TEST(HemiSpots, LobeSamplesStayOutOfTheStrata) {
     f->endPass();
     EXPECT_GT(recorded, 0);
     EXPECT_EQ(f->visitTable(), before);
+}
+
+// Every lobe query of two fields alike, from a few places of each region.
+int lobeMismatches(const HemiField& a, const HemiField& b) {
+    std::mt19937_64 rng(9);
+    int mismatches = 0;
+    for (int r = 0; r < a.numRegions(); ++r) {
+        mismatches += a.spots()->share(r) != b.spots()->share(r);
+        const glm::vec3 xc = a.regionPosition(r);
+        for (int i = 0; i < 8; ++i) {
+            const glm::vec3 x = xc + 0.01f * float(i) * glm::vec3(1.f, 0.5f, 0.f);
+            const glm::vec3 w = test::gaussianDirection(rng);
+            mismatches += a.pdfAt(r, x, w) != b.pdfAt(r, x, w);
+            float pa = 0.f, pb = 0.f;
+            const glm::vec2 u(0.3f + 0.05f * float(i), 0.6f);
+            const glm::vec3 sa = a.sampleAt(r, x, u, 0.01f, &pa);
+            const glm::vec3 sb = b.sampleAt(r, x, u, 0.01f, &pb);
+            mismatches += sa != sb || pa != pb;
+        }
+    }
+    return mismatches;
+}
+
+TEST(HemiSpots, SavedStateRestoresTheLobesAndLearnsOnAlike) {
+    const std::map<std::string, std::string> params = {
+        {"points", "16"}, {"spots", "2"}, {"warmup", "0"}};
+    auto f = makeHemi(params);
+    ASSERT_TRUE(f);
+    const int region = 4;
+    trainBright(*f, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);
+    const glm::vec3 xc = f->regionPosition(region);
+    trainSpot(*f, region, xc, xc + glm::vec3(0.6f, -0.3f, 0.5f), 0.02f, 1e4f, 2, 5);
+    ASSERT_GT(f->spots()->activeLobes(), 0u);
+    std::string state, error;
+    ASSERT_TRUE(f->saveState(&state, &error)) << error;
+    auto g = makeHemi(params);
+    ASSERT_TRUE(g->loadState(state, &error)) << error;
+    EXPECT_EQ(g->spots()->activeLobes(), f->spots()->activeLobes());
+    EXPECT_EQ(lobeMismatches(*f, *g), 0);
+    // Both learn a second spot alike (the restored accumulators match the candidates).
+    for (HemiField* h : {f.get(), g.get()})
+        trainSpot(*h, region, xc, xc + glm::vec3(-0.4f, 0.2f, 0.7f), 0.03f, 2e4f, 2, 6);
+    EXPECT_EQ(lobeMismatches(*f, *g), 0);
+    EXPECT_GT(f->spots()->activeLobes(), 1u);
+
+    // A field without spots loads the strata alone; one with another number of lobes per
+    // region refuses; a truncated section is refused.
+    auto plain = makeHemi({{"points", "16"}, {"warmup", "0"}});
+    EXPECT_TRUE(plain->loadState(state, &error)) << error;
+    EXPECT_EQ(plain->pdf(region, glm::vec3(0.f, 0.f, 1.f)), f->pdf(region, glm::vec3(0.f, 0.f, 1.f)));
+    auto other = makeHemi({{"points", "16"}, {"spots", "3"}, {"warmup", "0"}});
+    EXPECT_FALSE(other->loadState(state, &error));
+    EXPECT_NE(error.find("spots=2"), std::string::npos) << error;
+    std::string plainState;
+    ASSERT_TRUE(plain->saveState(&plainState, &error)) << error;
+    // (a field with spots loading one saved without them: the lobes start empty)
+    auto fresh = makeHemi(params);
+    EXPECT_TRUE(fresh->loadState(plainState, &error)) << error;
+    EXPECT_EQ(fresh->spots()->activeLobes(), 0u);
+}
+
+TEST(HemiSpots, CorruptLobeBytesAreRefused) {
+    SpotLobes a;
+    SpotSettings ss;
+    ss.perRegion = 2;
+    a.reset(3, ss);
+    a.beginPass(2);
+    for (int i = 0; i < 4; ++i)
+        a.record(i % 2, 1, glm::vec3(0.f), glm::vec3(0.f, 0.f, 1.f),
+                 glm::vec3(0.f, 0.01f * float(i), 1.f), 100.f, 1.f);
+    const std::string candidates = a.takeCandidates();
+    EXPECT_EQ(candidates.size(), 4u * 48u);
+    SpotLobes b;
+    b.reset(3, ss);
+    EXPECT_FALSE(b.putCandidates(candidates.substr(1)));
+    SpotLobes small;
+    small.reset(1, ss);  // region 1 does not exist there
+    EXPECT_FALSE(small.putCandidates(candidates));
+    ASSERT_TRUE(b.putCandidates(candidates));
+    b.endPass([](size_t) { return 1.0; });
+    EXPECT_EQ(b.activeLobes(), 1u);
+    const std::string saved = b.write();
+    SpotLobes c;
+    c.reset(3, ss);
+    std::string why;
+    EXPECT_TRUE(c.read(saved, &why)) << why;
+    EXPECT_FALSE(c.read(saved.substr(0, saved.size() - 3), &why));
+    std::string nan = saved;
+    // The first lobe's point.x (after perRegion, the region count and region 0's and 1's
+    // lobe counts) becomes a NaN.
+    const uint32_t nanBits = 0x7fc00000u;
+    std::memcpy(&nan[4 + 8 + 4 + 4], &nanBits, 4);
+    EXPECT_FALSE(c.read(nan, &why));
+    EXPECT_EQ(c.activeLobes(), 0u);
 }
 
 }  // namespace

@@ -108,6 +108,11 @@ struct Case {
     const char* name;
 };
 
+// Spot lobes that form within a few spp in the room (every direction that finds 1x its
+// stratum's estimate is a candidate, from the first pass on).
+constexpr const char* kSpots =
+    "--guide-param spots=4 --guide-param spot-outlier=1 --guide-param warmup=0";
+
 class TwoRanks : public ::testing::TestWithParam<Case> {};
 
 TEST_P(TwoRanks, EqualOneProcess) {
@@ -175,6 +180,7 @@ INSTANTIATE_TEST_SUITE_P(Backends, TwoRanks,
                                            Case{"hemi", false, "", "hemi"},
                                            Case{"hemi", false, "--guide-param mix=learn",
                                                 "hemiLearnedSelection"},
+                                           Case{"hemi", false, kSpots, "hemiSpots"},
                                            Case{"vdb", false, "", "vdb"},
                                            Case{"vdb", true, "", "vdbFog"}),
                          [](const ::testing::TestParamInfo<Case>& i) {
@@ -234,6 +240,7 @@ TEST(Distributed, ResumeOnAnotherRankCountWarns) {
 INSTANTIATE_TEST_SUITE_P(Backends, TwoRanksResume,
                          ::testing::Values(Case{"none", false, "", "none"},
                                            Case{"hemi", false, "", "hemi"},
+                                           Case{"hemi", false, kSpots, "hemiSpots"},
                                            Case{"vdb", true, "", "vdbFog"}),
                          [](const ::testing::TestParamInfo<Case>& i) {
                              return std::string(i.param.name);

@@ -197,6 +197,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"hemi", "mix=learn points=32", false, 8, "hemi_mix_learn"},
                       Case{"hemi", "learn=4", false, 6, "hemi_learn_4"},
                       Case{"hemi", "rr=adjoint", false, 10, "hemi_adjoint_roulette"},
+                      Case{"hemi", "spots=4 spot-outlier=1 warmup=0", false, 5, "hemi_spots"},
                       Case{"vdb", "samples=independent", false, 3, "vdb_independent"},
                       // Stopped before the auto trial's guided pass, and between its two.
                       Case{"hemi", "auto=4", false, 2, "hemi_auto_pending"},
