@@ -205,6 +205,10 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
     return 1;
 }
 
+// hemi's spot lobes per region by default (issue 30: veach-bidir's lamp openings; the
+// measurement is in docs/BENCHMARKS.md, "Spot lobes").
+constexpr int kDefaultSpots = 4;
+
 // Reads the hemi parameters; false and *error on an unknown key or a bad value.
 bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParams* hp,
                      double* maxMiB, std::string* error) {
@@ -256,6 +260,7 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
         *error = "guiding backend 'hemi': spots need directions=strata";
         return false;
     }
+    if (hp->spots < 0) hp->spots = hp->treeDirections ? 0 : kDefaultSpots;
     return true;
 }
 

@@ -78,7 +78,9 @@ struct HemiParams {
     bool treeDirections = false;
     double treeSplit = 0.03;
     int treeDepth = 12;
-    int spots = 0;            // spot lobes per region (0: off)
+    // Spot lobes per region (0: off; -1: the default, 4 with the strata and 0 with
+    // directions=tree; docs/GUIDING.md).
+    int spots = -1;
     double spotShare = 0.5;
     double spotOutlier = 10.0;
 };

@@ -76,10 +76,9 @@ const std::vector<GuideOption>& guideOptions() {
          "hemisphere's learned light"},
         {"tree-depth", O::kHemi, kField, "12", "an integer in 1..16",
          "directions=tree: the deepest level (leaf edge 2^-depth of the square)"},
-        {"spots", O::kHemi, kField, "0", "an integer in 0..16",
-         "narrow lobes per hemisphere aimed at small bright spots (highlights of lights on "
-         "near-specular surfaces) that a stratum is too coarse for (experimental; 0: off; no "
-         "--guide-save)"},
+        {"spots", O::kHemi, kField, "4 (0 with directions=tree)", "an integer in 0..16",
+         "narrow lobes per hemisphere aimed at small bright spots that a stratum is too coarse "
+         "for (a lamp's opening, a light's highlight on a near-specular surface; 0: off)"},
         {"spot-share", O::kHemi, kField, "0.5", "a number in (0, 1]",
          "spots: the largest probability of the lobes within the guide"},
         {"spot-outlier", O::kHemi, kField, "10", "a number >= 1",

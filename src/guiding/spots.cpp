@@ -48,12 +48,22 @@ glm::vec3 vmfSample(const glm::vec3& mean, float kappa, glm::vec2 u) {
 void SpotLobes::reset(size_t regions, const SpotSettings& settings) {
     settings_ = settings;
     settings_.perRegion = std::clamp(settings.perRegion, 1, 255);
-    lobes_.assign(regions * size_t(settings_.perRegion), Lobe());
+    block_.assign(regions, kNoBlock);
+    lobes_.clear();
+    lobes_.shrink_to_fit();
     lobeCount_.assign(regions, 0);
-    active_.assign(regions * size_t(settings_.perRegion), Active());
+    active_.clear();
+    active_.shrink_to_fit();
     activeCount_.assign(regions, 0);
     share_.assign(regions, 0.f);
     slots_.clear();
+}
+
+void SpotLobes::allocate(size_t region) {
+    if (block_[region] != kNoBlock) return;
+    block_[region] = uint32_t(lobes_.size() / size_t(settings_.perRegion));
+    lobes_.resize(lobes_.size() + size_t(settings_.perRegion));
+    active_.resize(active_.size() + size_t(settings_.perRegion));
 }
 
 glm::vec3 SpotLobes::lobeDirection(const Active& a, const glm::vec3& x) {
@@ -66,9 +76,9 @@ glm::vec3 SpotLobes::lobeDirection(const Active& a, const glm::vec3& x) {
 }
 
 glm::vec3 SpotLobes::sample(int region, const glm::vec3& x, glm::vec2 u, float uLobe) const {
-    const Active* a = &active_[size_t(region) * size_t(settings_.perRegion)];
     const int n = activeCount_[size_t(region)];
     if (n == 0) return glm::vec3(0.f);
+    const Active* a = activeOf(size_t(region));
     int i = 0;
     while (i + 1 < n && !(uLobe < a[i].cumWeight)) ++i;
     return vmfSample(lobeDirection(a[i], x), a[i].kappa, u);
@@ -76,8 +86,9 @@ glm::vec3 SpotLobes::sample(int region, const glm::vec3& x, glm::vec2 u, float u
 
 float SpotLobes::pdf(int region, const glm::vec3& x, const glm::vec3& w) const {
     if (region < 0 || size_t(region) >= activeCount_.size()) return 0.f;
-    const Active* a = &active_[size_t(region) * size_t(settings_.perRegion)];
     const int n = activeCount_[size_t(region)];
+    if (n == 0) return 0.f;
+    const Active* a = activeOf(size_t(region));
     float p = 0.f;
     for (int i = 0; i < n; ++i) {
         // e^(kappa (cos - 1)) below e^-40 adds nothing to a float sum with the strata's
@@ -108,7 +119,8 @@ void SpotLobes::mergeCandidates() {
     const int k = settings_.perRegion;
     for (auto& slot : slots_) {
         for (const Candidate& c : slot) {
-            Lobe* l = &lobes_[size_t(c.region) * size_t(k)];
+            allocate(c.region);
+            Lobe* l = lobesOf(c.region);
             uint8_t& n = lobeCount_[c.region];
             int best = -1;
             float bestErr = 0.f;
@@ -156,8 +168,8 @@ void SpotLobes::mergeCandidates() {
 }
 
 void SpotLobes::refit(size_t region, double regionTotal) {
-    Lobe* l = &lobes_[region * size_t(settings_.perRegion)];
-    Active* act = &active_[region * size_t(settings_.perRegion)];
+    Lobe* l = lobesOf(region);
+    Active* act = activeOf(region);
     const int n = lobeCount_[region];
     double active = 0.0;
     int m = 0;
@@ -242,7 +254,8 @@ std::string SpotLobes::write() const {
     w.u64(uint64_t(lobeCount_.size()));
     for (size_t r = 0; r < lobeCount_.size(); ++r) {
         w.u32(lobeCount_[r]);
-        const Lobe* l = &lobes_[r * size_t(settings_.perRegion)];
+        if (lobeCount_[r] == 0) continue;
+        const Lobe* l = lobesOf(r);
         for (int i = 0; i < lobeCount_[r]; ++i) {
             w.vec3(l[i].point);
             w.vec3(l[i].dir);
@@ -277,7 +290,9 @@ bool SpotLobes::read(const std::string& bytes, std::string* why) {
     for (size_t reg = 0; reg < regions; ++reg) {
         const uint32_t n = r.u32();
         if (!r.ok() || n > perRegion) return fail("corrupt spot lobes");
-        Lobe* l = &lobes_[reg * size_t(perRegion)];
+        if (n == 0) continue;
+        allocate(reg);
+        Lobe* l = lobesOf(reg);
         for (uint32_t i = 0; i < n; ++i) {
             l[i].point = r.vec3();
             l[i].dir = r.vec3();
@@ -305,7 +320,8 @@ bool SpotLobes::read(const std::string& bytes, std::string* why) {
 
 size_t SpotLobes::bytes() const {
     return lobes_.capacity() * sizeof(Lobe) + lobeCount_.capacity() + share_.capacity() * 4 +
-           active_.capacity() * sizeof(Active) + activeCount_.capacity();
+           active_.capacity() * sizeof(Active) + activeCount_.capacity() +
+           block_.capacity() * sizeof(uint32_t);
 }
 
 size_t SpotLobes::activeRegions() const {

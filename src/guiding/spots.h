@@ -41,8 +41,8 @@ public:
     }
     // Starts loading a region's lobes (a hint).
     void prefetch(int region) const {
-        if (region >= 0 && size_t(region) < activeCount_.size())
-            __builtin_prefetch(&active_[size_t(region) * size_t(settings_.perRegion)]);
+        if (region >= 0 && size_t(region) < activeCount_.size() && activeCount_[size_t(region)])
+            __builtin_prefetch(activeOf(size_t(region)));
     }
     // A direction from the lobes of `region` seen from x (share(region) > 0), u and uLobe in
     // [0, 1); its density is pdf(region, x, w).
@@ -129,9 +129,26 @@ private:
     void refit(size_t region, double regionTotal);
 
     SpotSettings settings_;
-    std::vector<Lobe> lobes_;           // regions x perRegion
+    // A region's perRegion lobes and actives, allocated with its first candidate: memory
+    // only where spots were found (block_: the region's block of lobes_ and active_).
+    static constexpr uint32_t kNoBlock = UINT32_MAX;
+    Lobe* lobesOf(size_t region) {
+        return &lobes_[size_t(block_[region]) * size_t(settings_.perRegion)];
+    }
+    const Lobe* lobesOf(size_t region) const {
+        return &lobes_[size_t(block_[region]) * size_t(settings_.perRegion)];
+    }
+    Active* activeOf(size_t region) {
+        return &active_[size_t(block_[region]) * size_t(settings_.perRegion)];
+    }
+    const Active* activeOf(size_t region) const {
+        return &active_[size_t(block_[region]) * size_t(settings_.perRegion)];
+    }
+    void allocate(size_t region);
+    std::vector<uint32_t> block_;       // per region, or kNoBlock
+    std::vector<Lobe> lobes_;           // blocks x perRegion
     std::vector<uint8_t> lobeCount_;    // used lobes per region
-    std::vector<Active> active_;        // regions x perRegion, the first activeCount_ used
+    std::vector<Active> active_;        // blocks x perRegion, the first activeCount_ used
     std::vector<uint8_t> activeCount_;
     std::vector<float> share_;          // frozen per pass
     std::vector<std::vector<Candidate>> slots_;

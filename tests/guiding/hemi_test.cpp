@@ -171,8 +171,12 @@ TEST(HemiField, DefaultsAndMemory) {
     EXPECT_EQ(f->params().smooth, 2.0);
     // Untrained, every region has its frame (one cache line) and block index, and all share
     // one block of tables: Q (double), estimates (float), visits (uint64), CDF (257 floats).
+    // The spot lobes (on by default) hold per region only their share, two counts and a
+    // block index until a region finds a spot.
     const size_t block = 256 * 20 + 257 * 4;
-    const size_t perRegion = size_t(f->numRegions()) * (64 + 4);
+    ASSERT_NE(f->spots(), nullptr);
+    EXPECT_EQ(f->spots()->settings().perRegion, 4);
+    const size_t perRegion = size_t(f->numRegions()) * (64 + 4 + 10);
     EXPECT_GE(f->bytes(), perRegion + block);
     // Points, tree and the lookup's cell memo: 8192 entries of one cache line.
     ASSERT_NE(f->cellCache(), nullptr);

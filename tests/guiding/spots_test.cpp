@@ -234,7 +234,7 @@ TEST(HemiSpots, SavedStateRestoresTheLobesAndLearnsOnAlike) {
 
     // A field without spots loads the strata alone; one with another number of lobes per
     // region refuses; a truncated section is refused.
-    auto plain = makeHemi({{"points", "16"}, {"warmup", "0"}});
+    auto plain = makeHemi({{"points", "16"}, {"spots", "0"}, {"warmup", "0"}});
     EXPECT_TRUE(plain->loadState(state, &error)) << error;
     EXPECT_EQ(plain->pdf(region, glm::vec3(0.f, 0.f, 1.f)), f->pdf(region, glm::vec3(0.f, 0.f, 1.f)));
     auto other = makeHemi({{"points", "16"}, {"spots", "3"}, {"warmup", "0"}});
