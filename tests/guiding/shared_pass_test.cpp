@@ -24,26 +24,23 @@
 namespace rlpbrt::guiding {
 namespace {
 
-// SumAcrossProcesses for K threads: each passes its array, the last to arrive adds them in
-// rank order and gives every thread the result.
+// K threads standing in for processes: each passes its value, the last to arrive combines
+// them in rank order and gives every thread the result.
 template <typename T>
-class ThreadSum {
+class Rendezvous {
 public:
-    explicit ThreadSum(int k) : k_(k), arrays_(size_t(k), nullptr) {}
-    void sum(int rank, std::vector<T>& v) {
+    explicit Rendezvous(int k) : k_(k), values_(size_t(k), nullptr) {}
+    template <class Combine>
+    void meet(int rank, T& v, Combine&& combine) {
         std::unique_lock<std::mutex> lock(mutex_);
-        arrays_[size_t(rank)] = &v;
+        values_[size_t(rank)] = &v;
         const long generation = generation_;
         if (++arrived_ < k_) {
             cv_.wait(lock, [&] { return generation_ != generation; });
             return;
         }
-        std::vector<T> total(v.size(), T(0));
-        for (std::vector<T>* a : arrays_) {
-            EXPECT_EQ(a->size(), total.size()) << "every rank passes arrays of the same size";
-            for (size_t i = 0; i < std::min(a->size(), total.size()); ++i) total[i] += (*a)[i];
-        }
-        for (std::vector<T>* a : arrays_) *a = total;
+        const T all = combine(values_);
+        for (T* x : values_) *x = all;
         ++calls_;
         arrived_ = 0;
         ++generation_;
@@ -54,39 +51,39 @@ public:
 private:
     int k_, arrived_ = 0, calls_ = 0;
     long generation_ = 0;
-    std::vector<std::vector<T>*> arrays_;
+    std::vector<T*> values_;
     std::mutex mutex_;
     std::condition_variable cv_;
 };
 
-// SumAcrossProcesses::gather for K threads: every thread's bytes in rank order.
-class ThreadGather {
+// SumAcrossProcesses's sums for K threads: element-wise, in rank order.
+template <typename T>
+class ThreadSum : public Rendezvous<std::vector<T>> {
 public:
-    explicit ThreadGather(int k) : k_(k), strings_(size_t(k), nullptr) {}
-    void gather(int rank, std::string& bytes) {
-        std::unique_lock<std::mutex> lock(mutex_);
-        strings_[size_t(rank)] = &bytes;
-        const long generation = generation_;
-        if (++arrived_ < k_) {
-            cv_.wait(lock, [&] { return generation_ != generation; });
-            return;
-        }
-        std::string all;
-        for (std::string* b : strings_) all += *b;
-        for (std::string* b : strings_) *b = all;
-        ++calls_;
-        arrived_ = 0;
-        ++generation_;
-        cv_.notify_all();
+    using Rendezvous<std::vector<T>>::Rendezvous;
+    void sum(int rank, std::vector<T>& v) {
+        this->meet(rank, v, [](const std::vector<std::vector<T>*>& arrays) {
+            std::vector<T> total(arrays[0]->size(), T(0));
+            for (const std::vector<T>* a : arrays) {
+                EXPECT_EQ(a->size(), total.size()) << "every rank passes arrays of the same size";
+                for (size_t i = 0; i < std::min(a->size(), total.size()); ++i) total[i] += (*a)[i];
+            }
+            return total;
+        });
     }
-    int calls() const { return calls_; }
+};
 
-private:
-    int k_, arrived_ = 0, calls_ = 0;
-    long generation_ = 0;
-    std::vector<std::string*> strings_;
-    std::mutex mutex_;
-    std::condition_variable cv_;
+// SumAcrossProcesses::gather for K threads: every thread's bytes in rank order.
+class ThreadGather : public Rendezvous<std::string> {
+public:
+    using Rendezvous<std::string>::Rendezvous;
+    void gather(int rank, std::string& bytes) {
+        meet(rank, bytes, [](const std::vector<std::string*>& strings) {
+            std::string all;
+            for (const std::string* b : strings) all += *b;
+            return all;
+        });
+    }
 };
 
 constexpr int kSlots = 7;
