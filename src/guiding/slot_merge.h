@@ -17,11 +17,20 @@
 
 namespace rlpbrt::guiding {
 
+// Memory for a large buffer that is written in full soon after (the merged records of a
+// pass): from 4 MiB on it is aligned to 2 MiB and the kernel is asked for transparent huge
+// pages, so that first touching it takes one page fault per 2 MiB instead of one per 4 KiB
+// (profiled: the faults were 2-3% of a guided render's time on cornell-box). Smaller sizes
+// come from operator new. Both are released with releaseLargeBuffer(p, bytes).
+void* allocateLargeBuffer(size_t bytes);
+void releaseLargeBuffer(void* p, size_t bytes) noexcept;
+
 // An allocator whose vectors leave new elements of trivial types uninitialised on resize():
 // the merge below writes every element, so zeroing them first would be a wasted pass over
-// memory that is often fresh from the kernel.
+// memory that is often fresh from the kernel. Its memory comes from allocateLargeBuffer.
 template <class T>
 struct NoInitAllocator : std::allocator<T> {
+    using value_type = T;
     template <class U>
     struct rebind {
         using other = NoInitAllocator<U>;
@@ -29,6 +38,11 @@ struct NoInitAllocator : std::allocator<T> {
     NoInitAllocator() = default;
     template <class U>
     NoInitAllocator(const NoInitAllocator<U>&) noexcept {}
+    T* allocate(size_t n) {
+        if (n > size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+        return static_cast<T*>(allocateLargeBuffer(n * sizeof(T)));
+    }
+    void deallocate(T* p, size_t n) noexcept { releaseLargeBuffer(p, n * sizeof(T)); }
     template <class U>
     void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
         ::new (static_cast<void*>(p)) U;

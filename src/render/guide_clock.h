@@ -2,8 +2,9 @@
 // path in kGuideClockEvery per thread is timed, and on it every call into the guide (the
 // region lookup, sampling and pdf evaluation, the roulette's learned light, and the training
 // records of the PathRecorder) adds its wall time to PathStats::guideNanos. Timing every path
-// would cost about as much as the work it measures; one in 16 costs well under 1% and its
-// mean converges over the render's millions of paths. A timer's own cost (two clock reads,
+// would cost about as much as the work it measures; one in 16 still cost 2-3% of a guided
+// render in this VM (its clock reads are slow: profiled on cornell-box), one in 128 costs
+// well under 1%, and the mean converges over the render's millions of paths. A timer's own cost (two clock reads,
 // tens of ns: as much as a pdf evaluation) is measured once (timerOverheadNanos) and taken
 // off per timed call.
 #pragma once
@@ -13,7 +14,7 @@
 
 namespace rlpbrt {
 
-constexpr uint64_t kGuideClockEvery = 16;
+constexpr uint64_t kGuideClockEvery = 128;
 
 // The time measured on timed paths, and the number of timed calls.
 struct GuideClockSums {
