@@ -105,6 +105,7 @@ HemiField::HemiField(const HemiParams& params, const SceneInfo& scene)
         ss.perRegion = params.spots;
         ss.maxShare = params.spotShare;
         ss.outlier = params.spotOutlier;
+        ss.minKappa = float(strata_);
         spots_ = std::make_unique<SpotLobes>();
         spots_->reset(regions, ss);
     }

@@ -22,6 +22,11 @@ struct SpotSettings {
     int perRegion = 4;        // lobes per region
     double maxShare = 0.5;    // the largest probability of the lobes within the guide
     double outlier = 10.0;    // a record is a spot candidate above outlier x its stratum's Q
+    // A lobe samples only while narrower than this concentration. The field sets it to its
+    // strata count: a von Mises-Fisher lobe of concentration kappa spreads over about
+    // 2 pi / kappa steradians, a hemisphere's stratum covers 2 pi / strata, so a wider lobe
+    // only repeats what the strata learn (and costs a density evaluation at every vertex).
+    float minKappa = 0.f;
 };
 
 // The von Mises-Fisher distribution on the sphere around unit `mean` with concentration
@@ -115,7 +120,7 @@ private:
         float norm = 0.f;     // weight x kappa / (2 pi (1 - e^-2kappa))
         float cumWeight = 0.f;  // the selection CDF up to this lobe
         uint32_t aimsAtPoint = 0;
-        float pad = 0.f;
+        float cosCut = -2.f;  // below this cosine to the lobe its density is skipped (pdf)
     };
     struct Candidate {
         uint32_t region;

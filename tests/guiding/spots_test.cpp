@@ -283,5 +283,44 @@ TEST(HemiSpots, CorruptLobeBytesAreRefused) {
     EXPECT_EQ(c.activeLobes(), 0u);
 }
 
+// Lobes sample only where they add to the strata: narrower than SpotSettings::minKappa (the
+// field's strata count) and carrying at least 1% of their region's learned light. A wide
+// cluster of candidates and a faint narrow one give no active lobe (share 0, density 0); the
+// same narrow cluster against a small region total does.
+TEST(SpotLobes, WideOrFaintLobesDoNotSample) {
+    SpotSettings ss;
+    ss.perRegion = 2;
+    ss.minKappa = 256.f;
+    auto train = [&](float spread, double regionTotal) {
+        SpotLobes lobes;
+        lobes.reset(1, ss);
+        lobes.beginPass(1);
+        // Directions about +z, `spread` apart in x and y, towards hits at distance 1.
+        for (int i = 0; i < 8; ++i) {
+            const glm::vec3 w = glm::normalize(
+                glm::vec3(spread * float(i % 3 - 1), spread * float(i / 3 - 1), 1.f));
+            lobes.record(0, 0, glm::vec3(0.f), w, w, 100.f, 1.f);
+        }
+        lobes.endPass([regionTotal](size_t) { return regionTotal; });
+        return lobes;
+    };
+    const glm::vec3 up(0.f, 0.f, 1.f);
+    SpotLobes narrow = train(0.002f, 1000.0);  // 800 of 1000: a spot
+    EXPECT_EQ(narrow.activeLobes(), 1u);
+    EXPECT_GT(narrow.share(0), 0.f);
+    EXPECT_GT(narrow.pdf(0, glm::vec3(0.f), up), 100.f);
+    SpotLobes wide = train(0.04f, 1000.0);  // about 2 degrees apart: wider than a stratum
+    EXPECT_EQ(wide.activeLobes(), 0u);
+    EXPECT_EQ(wide.share(0), 0.f);
+    EXPECT_EQ(wide.pdf(0, glm::vec3(0.f), up), 0.f);
+    ss.minKappa = 0.f;  // (the same cluster does fit a lobe: it is the width that stops it)
+    EXPECT_EQ(train(0.04f, 1000.0).activeLobes(), 1u);
+    ss.minKappa = 256.f;
+    SpotLobes faint = train(0.002f, 1e6);  // 800 of 10^6
+    EXPECT_EQ(faint.activeLobes(), 0u);
+    EXPECT_EQ(faint.share(0), 0.f);
+    EXPECT_EQ(faint.pdf(0, glm::vec3(0.f), up), 0.f);
+}
+
 }  // namespace
 }  // namespace rlpbrt::guiding
