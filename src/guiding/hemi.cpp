@@ -470,7 +470,7 @@ double HemiField::learnedTotal(size_t region) const {
 
 void HemiField::endPass() {
     table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
-    if (spots_) spots_->endPass([this](size_t r) { return learnedTotal(r); });
+    if (spots_) spots_->endPass(learnedTotals());
     if (trees_) {
         trees_->endPass();
         updateTreeRegions();
@@ -505,7 +505,7 @@ void HemiField::endPassShared(const SumAcrossProcesses& sum) {
         sum.gather(candidates);
         if (!spots_->putCandidates(candidates))
             throw std::runtime_error("hemi: the ranks' spot candidates are corrupt");
-        spots_->endPass([this](size_t r) { return learnedTotal(r); });
+        spots_->endPass(learnedTotals());
     }
 }
 
@@ -700,7 +700,7 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
     }
     table_.assign(std::move(q), std::move(visits), policy());
     table_.stats() = s;
-    if (spots_) spots_->refitAll([this](size_t reg) { return learnedTotal(reg); });
+    if (spots_) spots_->refitAll(learnedTotals());
     return true;
 }
 

@@ -307,6 +307,10 @@ private:
     // The sum of every target a region has learned (its strata's Q x visits): the spot
     // lobes' share is set against it.
     double learnedTotal(size_t region) const;
+    // learnedTotal as the function SpotLobes' endPass and refitAll take.
+    auto learnedTotals() const {
+        return [this](size_t region) { return learnedTotal(region); };
+    }
     uint64_t attempts_ = 0;  // samplePoint calls made at construction
 };
 

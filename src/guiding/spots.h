@@ -6,7 +6,8 @@
 // Each lobe is aimed either at a point (the spot's mean position: the direction then depends
 // on the vertex, parallax-aware, right for curved highlights) or along a fixed direction (a
 // flat mirror's reflected sun), whichever the records fit better; its width is fitted to the
-// records' spread. Standard library and GLM only; knows nothing of the strata or the scene.
+// records' spread. Standard library, GLM and the guide files' byte format (field_io.h);
+// knows nothing of the strata or the scene.
 #pragma once
 
 #include <cstddef>
