@@ -82,7 +82,7 @@ struct HemiParams {
     // directions=tree; docs/GUIDING.md).
     int spots = -1;
     double spotShare = 0.5;
-    double spotOutlier = 10.0;
+    double spotOutlier = 5.0;
 };
 
 // Estimated bytes of a hemi field with these parameters (tables, CDFs, points, kd-tree).

@@ -81,7 +81,7 @@ const std::vector<GuideOption>& guideOptions() {
          "for (a lamp's opening, a light's highlight on a near-specular surface; 0: off)"},
         {"spot-share", O::kHemi, kField, "0.5", "a number in (0, 1]",
          "spots: the largest probability of the lobes within the guide"},
-        {"spot-outlier", O::kHemi, kField, "10", "a number >= 1",
+        {"spot-outlier", O::kHemi, kField, "5", "a number >= 1",
          "spots: a direction's light at the next vertex must exceed this multiple of its "
          "stratum's estimate to shape a lobe"},
         // vdb only.

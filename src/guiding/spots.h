@@ -22,7 +22,7 @@ namespace rlpbrt::guiding {
 struct SpotSettings {
     int perRegion = 4;        // lobes per region
     double maxShare = 0.5;    // the largest probability of the lobes within the guide
-    double outlier = 10.0;    // a record is a spot candidate above outlier x its stratum's Q
+    double outlier = 5.0;     // a record is a spot candidate above outlier x its stratum's Q
     // A lobe samples only while narrower than this concentration. The field sets it to its
     // strata count: a von Mises-Fisher lobe of concentration kappa spreads over about
     // 2 pi / kappa steradians, a hemisphere's stratum covers 2 pi / strata, so a wider lobe
