@@ -101,16 +101,15 @@ float SpotLobes::pdf(int region, const glm::vec3& x, const glm::vec3& w) const {
         // e^(kappa (cos - 1)) below e^-kSkipExponent adds nothing to a float sum with the
         // strata's densities: skip it, and for a lobe aimed at a point skip its direction's
         // square root where the squared cosine already says so (most lobes are narrow).
-        float c;
+        float c = glm::dot(w, a[i].axis);  // a lobe along a direction
         if (a[i].aimsAtPoint) {
             const glm::vec3 d = a[i].axis - x;
             const float len2 = glm::dot(d, d), dw = glm::dot(w, d);
-            if (a[i].cosCut > 0.f && len2 > 0.f && std::isfinite(len2) &&
+            const bool regular = len2 > 0.f && std::isfinite(len2);
+            if (regular && a[i].cosCut > 0.f &&
                 (dw <= 0.f || dw * dw <= a[i].cosCut * a[i].cosCut * len2))
                 continue;
-            c = glm::dot(w, lobeDirection(a[i], x));
-        } else {
-            c = glm::dot(w, a[i].axis);
+            c = regular ? dw / std::sqrt(len2) : glm::dot(w, lobeDirection(a[i], x));
         }
         const float e = a[i].kappa * (std::min(c, 1.f) - 1.f);
         if (e > -kSkipExponent) p += a[i].norm * std::exp(e);

@@ -4,9 +4,9 @@
 // records of the PathRecorder) adds its wall time to PathStats::guideNanos. Timing every path
 // would cost about as much as the work it measures; one in 16 still cost 2-3% of a guided
 // render in this VM (its clock reads are slow: profiled on cornell-box), one in 128 costs
-// well under 1%, and the mean converges over the render's millions of paths. A timer's own cost (two clock reads,
-// tens of ns: as much as a pdf evaluation) is measured once (timerOverheadNanos) and taken
-// off per timed call.
+// well under 1%, and the mean converges over the render's millions of paths. A timer's own
+// cost (two clock reads, tens of ns: as much as a pdf evaluation) is measured once
+// (timerOverheadNanos) and taken off per timed call.
 #pragma once
 
 #include <chrono>
