@@ -43,6 +43,9 @@ float GuidingField::pdfAt(int region, const glm::vec3&, const glm::vec3& w, int*
 void GuidingField::recordSpot(int, int, const glm::vec3&, const glm::vec3&, const glm::vec3&,
                               float, int) {}
 bool GuidingField::learnsSpots() const { return false; }
+bool GuidingField::enableChoices(int) { return false; }
+GuidingField::Choice GuidingField::choice(int) const { return Choice(); }
+void GuidingField::recordChoice(int, int, int, float) {}
 
 void SumAcrossProcesses::sumCounts(std::vector<uint64_t>& v, double bound) const {
     if (bound < countLimit) {

@@ -203,6 +203,29 @@ public:
     // integrator then uses its mix setting). Default: -1.
     virtual float selection(int region) const;
 
+    // ---- Learned choices (the integrator's light selection for next-event estimation): a
+    // field may learn, per region, the mean value each of n options found (the light a shadow
+    // ray went to, and the contribution it brought: zero where the light was hidden) and
+    // answer with a distribution proportional to the means, frozen per pass like the policy.
+    // Enables n options (2..kMaxChoices), before the first beginPass; false where the backend
+    // does not learn choices (the default).
+    static constexpr int kMaxChoices = 16;
+    virtual bool enableChoices(int n);
+    // The learned distribution of `region`: a CDF of n + 1 floats (cdf[0] = 0, cdf[n] = 1)
+    // and how far it is trusted (weight in (0, 1], growing with the region's records), or
+    // {nullptr, 0} where the region has none yet (or choices are off); and whether the region
+    // still learns (takes recordChoice's records: a region stops once it holds enough).
+    // Default: none, not learning.
+    struct Choice {
+        const float* cdf = nullptr;
+        float weight = 0.f;
+        bool learning = false;
+    };
+    virtual Choice choice(int region) const;
+    // Records that at `region` option k found `value` (luminance, >= 0 and finite, else
+    // counted as rejected); thread-safe across slots like record(). Default: ignored.
+    virtual void recordChoice(int slot, int region, int k, float value);
+
     // ---- Learning: through TrainingSlot, one per work item (film tile).
     TrainingSlot slot(int index);
     // Learning: during a pass, record that from `region` the direction w received target T
@@ -293,6 +316,10 @@ public:
     float confidence() const { return field_->confidence(region_); }
     // The learned probability of choosing the guide, or -1 where none is learned.
     float selection() const { return field_->selection(region_); }
+    // GuidingField::choice for the region (none for an invalid guide).
+    GuidingField::Choice choice() const {
+        return field_ ? field_->choice(region_) : GuidingField::Choice();
+    }
     glm::vec3 sample(glm::vec2 u, float uStratum, float* pdf, int* bin = nullptr) const {
         return field_->sampleAt(region_, p_, u, uStratum, pdf, bin);
     }
@@ -327,6 +354,10 @@ public:
     // Target T (luminance) for direction w at the vertex of `guide` (GuidingField::record).
     void record(const VertexGuide& guide, const glm::vec3& w, float target, int bin = -1) {
         field_->record(slot_, guide.region(), w, target, bin);
+    }
+    // Option k found `value` at the vertex of `guide` (GuidingField::recordChoice).
+    void recordChoice(const VertexGuide& guide, int k, float value) {
+        field_->recordChoice(slot_, guide.region(), k, value);
     }
     // Direction w of the vertex of `guide` reached `hit`, which gave `light`
     // (GuidingField::recordSpot).

@@ -214,6 +214,10 @@ int HemiField::prefetched(int region) const {
     // -17% profile samples of a guided render.
     prefetchLine(&frames_[size_t(region)]);
     if (spots_) spots_->prefetch(region);
+    if (choices_) {  // the learned light choice, read by the vertex's next-event estimation
+        prefetchLine(&choiceWeight_[size_t(region)]);
+        prefetchLines(choices_->cdf(size_t(region)), size_t(choices_->strata() + 1) * sizeof(float));
+    }
     prefetchLines(cdf(region), size_t(strata_ + 1) * sizeof(float));
     // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
     // targets): a read without the prefetch waits (cornell-box, 64 spp, perf: radiance() 705
@@ -405,8 +409,44 @@ float HemiField::policyRadiance(int region, const glm::vec3& w, int bin) const {
     return q > 0.f ? std::min(q, FLT_MAX) : 0.f;  // (NaN -> 0)
 }
 
+namespace {
+// The learned choices' CDF: proportional to the options' mean values (uniform while all are 0).
+void choicePolicy(int, const double* q, int n, float* cdf) { buildStrataCdf(q, n, 0.0, cdf); }
+}  // namespace
+
+bool HemiField::enableChoices(int n) {
+    if (n < 2 || n > kMaxChoices) return false;
+    choices_ = std::make_unique<StrataTable>();
+    const int options = n;
+    choices_->reset(size_t(numRegions()), n, 0.0,
+                    [options](int r, const double* q, float* cdf) {
+                        choicePolicy(r, q, options, cdf);
+                    },
+                    /*lazy=*/true);
+    choiceWeight_.assign(size_t(numRegions()), 0.f);
+    return true;
+}
+
+void HemiField::updateChoiceWeights() {
+    for (size_t r = 0; r < choiceWeight_.size(); ++r) {
+        const float c = choices_->confidence(r, kChoiceWarmup);
+        choiceWeight_[r] = c >= kChoiceMinWeight ? c : 0.f;
+    }
+}
+
+void HemiField::recordChoice(int slot, int region, int k, float value) {
+    if (!choices_ || !validRegion(region) || k < 0 || k >= choices_->strata()) return;
+    choices_->record(slot, region, value, [k] { return k; });
+}
+
+StrataTable::PolicyBuilder HemiField::choicesPolicy() const {
+    const int n = choices_ ? choices_->strata() : 0;
+    return [n](int r, const double* q, float* cdf) { choicePolicy(r, q, n, cdf); };
+}
+
 void HemiField::beginPass(int numSlots) {
     table_.beginPass(numSlots);
+    if (choices_) choices_->beginPass(numSlots);
     if (spots_) spots_->beginPass(numSlots);
     if (trees_) trees_->beginPass(numSlots);
 }
@@ -470,6 +510,10 @@ double HemiField::learnedTotal(size_t region) const {
 
 void HemiField::endPass() {
     table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
+    if (choices_) {
+        choices_->endPass(/*alphaVisits=*/true, 0.0, choicesPolicy());
+        updateChoiceWeights();
+    }
     if (spots_) spots_->endPass(learnedTotals());
     if (trees_) {
         trees_->endPass();
@@ -499,6 +543,10 @@ void HemiField::updateTreeRegions() {
 
 void HemiField::endPassShared(const SumAcrossProcesses& sum) {
     table_.endPassShared(params_.alphaVisits, params_.fixedAlpha, policy(), sum);
+    if (choices_) {
+        choices_->endPassShared(/*alphaVisits=*/true, 0.0, choicesPolicy(), sum);
+        updateChoiceWeights();
+    }
     if (spots_) {
         // Every rank's candidates, merged in slot order on each (SpotLobes::takeCandidates).
         std::string candidates = spots_->takeCandidates();
@@ -510,7 +558,8 @@ void HemiField::endPassShared(const SumAcrossProcesses& sum) {
 }
 
 size_t HemiField::bytes() const {
-    return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (spots_ ? spots_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
+    return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (spots_ ? spots_->bytes() : 0) +
+           (choices_ ? choices_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
            frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +
            (cache_ ? cache_->bytes() : 0) + size_t(numPatches_) * sizeof(uint32_t);
 }
@@ -618,6 +667,16 @@ std::string HemiField::serialize() const {
         w.u32(kSpotsSection);
         w.blob(spots_->write());
     }
+    // The learned choices (an optional section after the lobes): options, then Q and visits
+    // of every region.
+    if (choices_) {
+        fieldio::Writer c;
+        c.u32(uint32_t(choices_->strata()));
+        for (double d : choices_->denseQ()) c.f64(d);
+        for (uint64_t v : choices_->denseVisits()) c.u64(v);
+        w.u32(kChoicesSection);
+        w.blob(c.data);
+    }
     return std::move(w.data);
 }
 
@@ -687,11 +746,37 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
     if (!r.ok()) return fail("truncated tables");
     // The spot lobes, if saved: a field without spots uses the strata alone; one with spots
     // loading a field saved without them starts its lobes empty.
-    std::string lobes;
-    if (r.remaining() > 0) {
-        if (r.u32() != kSpotsSection) return fail("unknown data after the tables");
-        lobes = r.blob();
-        if (!r.ok() || r.remaining() != 0) return fail("truncated spot lobes");
+    std::string lobes, choices;
+    while (r.remaining() > 0) {
+        const uint32_t tag = r.u32();
+        if (tag == kSpotsSection && lobes.empty()) {
+            lobes = r.blob();
+            if (!r.ok()) return fail("truncated spot lobes");
+        } else if (tag == kChoicesSection && choices.empty()) {
+            choices = r.blob();
+            if (!r.ok()) return fail("truncated learned choices");
+        } else {
+            return fail("unknown data after the tables");
+        }
+    }
+    // The learned choices, if both the file and this field have them (a field that loads a
+    // file without them starts them empty; one without choices ignores the file's).
+    std::vector<double> choiceQ;
+    std::vector<uint64_t> choiceVisits;
+    if (choices_ && !choices.empty()) {
+        fieldio::Reader c(choices);
+        const uint32_t n = c.u32();
+        if (!c.ok() || int(n) != choices_->strata())
+            return fail("learned choices of another number of options");
+        const size_t cells = size_t(numRegions()) * n;
+        if (c.remaining() != cells * 16) return fail("learned choices of another size");
+        choiceQ.resize(cells);
+        choiceVisits.resize(cells);
+        for (double& d : choiceQ) {
+            d = c.f64();
+            if (!(d >= 0.0) || !std::isfinite(d)) return fail("corrupt learned choices");
+        }
+        for (uint64_t& v : choiceVisits) v = c.u64();
     }
     if (spots_) {
         std::string why;
@@ -700,6 +785,14 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
     }
     table_.assign(std::move(q), std::move(visits), policy());
     table_.stats() = s;
+    if (choices_) {
+        if (choiceQ.empty()) {
+            enableChoices(choices_->strata());
+        } else {
+            choices_->assign(std::move(choiceQ), std::move(choiceVisits), choicesPolicy());
+            updateChoiceWeights();
+        }
+    }
     if (spots_) spots_->refitAll(learnedTotals());
     return true;
 }

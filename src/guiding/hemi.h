@@ -126,6 +126,14 @@ public:
     void recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
                     const glm::vec3& hit, float light, int bin = -1) override;
     bool learnsSpots() const override { return spots_ != nullptr; }
+    bool enableChoices(int n) override;
+    Choice choice(int region) const override {
+        if (!choices_ || !validRegion(region)) return Choice();
+        const float w = choiceWeight_[size_t(region)];
+        return Choice{w > 0.f ? choices_->cdf(size_t(region)) : nullptr, std::max(w, 0.f),
+                      w < kChoiceFullWeight};
+    }
+    void recordChoice(int slot, int region, int k, float value) override;
     const SpotLobes* spots() const { return spots_.get(); }
     float scatteredEstimate(int region,
                             const std::function<float(const glm::vec3&)>& fcos) const override;
@@ -230,6 +238,8 @@ private:
     const float* cdf(int region) const { return table_.cdf(size_t(region)); }
     // Rebuilds a region's CDF, then its moment and confidence (called per updated region,
     // concurrently for distinct regions).
+    // The learned choices' policy (their CDF proportional to the means).
+    StrataTable::PolicyBuilder choicesPolicy() const;
     StrataTable::PolicyBuilder policy() {
         return [this](int region, const double* q, float* c) {
             buildPolicy(q, c);
@@ -242,6 +252,19 @@ private:
     static constexpr int kSpotBin = 1 << 24;
     // The tag of a saved field's spot-lobe section.
     static constexpr uint32_t kSpotsSection = 0x53504f54;  // "SPOT"
+    // ... and of its learned choices' section (enableChoices).
+    static constexpr uint32_t kChoicesSection = 0x43484f49;  // "CHOI"
+    // How far a region's learned choice is trusted: its confidence with kChoiceWarmup records
+    // per option (records / (records + warmup x options)), 0 below kChoiceMinWeight: a
+    // handful of shadow rays cannot tell a hidden light from an unlucky one.
+    static constexpr double kChoiceWarmup = 16.0;
+    static constexpr float kChoiceMinWeight = 0.25f;
+    // A region stops learning its choice at kChoiceFull records per option (its weight then
+    // 1024 / (1024 + 16)): the mean of each light moves little after that, and the records
+    // cost the time of a few percent of the render (sorting and merging at every pass).
+    static constexpr double kChoiceFull = 1024.0;
+    static constexpr float kChoiceFullWeight = float(kChoiceFull / (kChoiceFull + kChoiceWarmup));
+    void updateChoiceWeights();
 
     HemiParams params_;
     StrataLayout layout_;
@@ -255,6 +278,10 @@ private:
     std::unique_ptr<PointKdTree> tree_;
     std::unique_ptr<CellCache> cache_;  // lookup=cell only
     std::unique_ptr<SpotLobes> spots_;  // spots > 0 only
+    // Learned choices (enableChoices): per region the running mean of each option's value,
+    // its CDF proportional to the means.
+    std::unique_ptr<StrataTable> choices_;
+    std::vector<float> choiceWeight_;  // per region (choice()), set at endPass
     // lookup=patch: per patch 0 (not yet filled), point + 1, or kNoPoint (no admissible
     // point), read and written with relaxed atomics (a fill is a pure function of the patch,
     // so racing fills agree); zeroed pages from calloc, so a large table of patches that no

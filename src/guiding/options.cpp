@@ -28,6 +28,10 @@ const std::vector<GuideOption>& guideOptions() {
          "estimate continues as up to this many paths (1: off)"},
         {"split-window", O::kBoth, kIntegrator, "3", "a positive number",
          "split: the multiple of the pixel's estimate above which a path splits"},
+        {"lights", O::kBoth, kIntegrator, "learned", "\"learned\" or \"scene\"",
+         "next-event estimation's light selection: learned per region from what its shadow "
+         "rays found, mixed with the scene's lightsamplestrategy (scenes of 2 to 16 lights, "
+         "hemi), or the scene's strategy alone"},
         {"samples", O::kBoth, kIntegrator, "sequence", "\"sequence\" or \"independent\"",
          "passes continue one low-discrepancy sequence per pixel, or draw independent sets "
          "(exactly unbiased, less stratified)"},

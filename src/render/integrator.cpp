@@ -125,6 +125,11 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
             return badOption("split-window", splitWindow->second, error);
         settings->splitWindow = v;
     }
+    auto lightsParam = config.params.find("lights");
+    const bool learnLights = lightsParam == config.params.end() || lightsParam->second == "learned";
+    if (lightsParam != config.params.end() && lightsParam->second != "learned" &&
+        lightsParam->second != "scene")
+        return badOption("lights", lightsParam->second, error);
     auto learn = config.params.find("learn");
     if (learn != config.params.end() && learn->second != "all" &&
         !parseSampleCount(learn->second, &settings->learnSpp)) {
@@ -148,6 +153,11 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     *field = guiding::createGuidingField(config, info, error);
     if (!*field) return false;
     settings->field = field->get();
+    // Learned light choices for scenes of a few lights (each region keeps a mean per light).
+    const size_t lights = scene.lights.size();
+    settings->learnLights = learnLights && lights >= 2 &&
+                            lights <= size_t(guiding::GuidingField::kMaxChoices) &&
+                            (*field)->enableChoices(int(lights));
     const float patchSize = (*field)->patchSize();
     if (patchSize > 0.f) {
         // At most 2^24 patches (64 MiB of memo at most, in pages touched only where paths
@@ -257,28 +267,50 @@ void PathIntegrator::takeDirection(PathState& s, const SurfaceInteraction& si, c
 
 Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& bsdf,
                                      GuideMixture& guide, Sampler& sampler, PathStats& stats,
-                                     const PathMedium* media) const {
+                                     const PathMedium* media,
+                                     const guiding::GuidingField::Choice& choice,
+                                     PathRecorder* rec,
+                                     const guiding::VertexGuide* region) const {
     float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
     float pmf;
-    int li = lights_->sample(si.p, uLight, &pmf);
+    const int li = lightChoice(choice).sample(si.p, uLight, &pmf);
     if (li < 0 || pmf == 0.f) return Spectrum(0.f);
+    // What the shadow ray found for the learned choice: Le f cos / pdf where the light is
+    // visible, 0 where not (before the selection's probability and the MIS weight).
+    const bool learns = rec && region && region->valid();
+    auto found = [&](float value) {
+        if (learns) rec->lightChosen(*region, li, value);
+    };
     const Light& light = *scene_.lights[size_t(li)];
     LightSampleContext ctx{si.p, si.ng};
     LightSample ls;
-    if (!light.sampleLi(ctx, u, &ls) || !ls.valid()) return Spectrum(0.f);
+    if (!light.sampleLi(ctx, u, &ls) || !ls.valid()) {
+        found(0.f);
+        return Spectrum(0.f);
+    }
     Spectrum f = bsdf.f(si.wo, ls.wi) * std::abs(glm::dot(ls.wi, si.ns));
-    if (isBlack(f)) return Spectrum(0.f);
+    if (isBlack(f)) {
+        found(0.f);
+        return Spectrum(0.f);
+    }
     Vec3 o = spawnOrigin(si, ls.wi, originScale_);
     float tMax = std::isinf(ls.dist) ? Infinity : ls.dist * (1.f - 1e-4f);
     if (media) {
         f *= transmittance(o, ls.wi, tMax, si.mediumAfter(ls.wi, media->medium), *media->rng,
                            stats);
-        if (isBlack(f)) return Spectrum(0.f);
+        if (isBlack(f)) {
+            found(0.f);
+            return Spectrum(0.f);
+        }
     } else {
         ++stats.rays;
-        if (scene_.occluded(o, ls.wi, tMax)) return Spectrum(0.f);
+        if (scene_.occluded(o, ls.wi, tMax)) {
+            found(0.f);
+            return Spectrum(0.f);
+        }
     }
+    found(luminance(f * ls.L) / ls.pdf);
     if (ls.isDelta) return f * ls.L / (pmf * ls.pdf);
     float lightPdf = pmf * ls.pdf;
     float w = powerHeuristic(1, lightPdf, 1, mixturePdf(guide, ls.wi, bsdf.pdf(si.wo, ls.wi)));
@@ -404,6 +436,7 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     s.dirPdf = ds.pdf;
     s.specularBounce = false;
     s.prev = LightSampleContext{p, Vec3(0.f)};
+    s.prevChoice = {};
     s.ray = Ray(p, ds.wi);
     if (!pbrtRoulette(&s.beta, s.etaScale, bounces, rrThreshold_, sampler)) return Step::End;
     return Step::Scattered;
@@ -464,6 +497,7 @@ PathIntegrator::Step PathIntegrator::subsurfaceStep(PathState& s, const SurfaceI
     s.dirPdf = bs.pdf;
     s.specularBounce = false;
     s.prev = LightSampleContext{pi.p, pi.ng};
+    s.prevChoice = {};
     if (media) s.pm.medium = pi.mediumAfter(bs.wi, s.pm.medium);
     s.ray.o = spawnOrigin(pi, bs.wi, originScale_);
     s.ray.d = bs.wi;
@@ -553,7 +587,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                     if (bounces == 0 || s.specularBounce) {
                         s.L += s.beta * Le;
                     } else {
-                        float lightPdf = lights_->pmf(s.prev.p, idx) *
+                        float lightPdf = lightPmf(s.prev.p, s.prevChoice, idx) *
                                          light.pdfLi(s.prev, s.ray.d, Vec3(0.f), Vec3(0.f));
                         s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
                     }
@@ -571,7 +605,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                     if (bounces == 0 || s.specularBounce) {
                         s.L += s.beta * Le;
                     } else {
-                        float lightPdf = lights_->pmf(s.prev.p, si.light) *
+                        float lightPdf = lightPmf(s.prev.p, s.prevChoice, si.light) *
                                          light.pdfLi(s.prev, s.ray.d, si.p, si.ng);
                         s.L += s.beta * Le * powerHeuristic(1, s.dirPdf, 1, lightPdf);
                     }
@@ -621,11 +655,17 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
 
             // Next-event estimation at non-specular vertices (first: its shadow ray gives the
             // guide's prefetch of the region's tables time to land).
+            s.prevChoice = {};
             if (!lastVertex) {
                 ++stats.vertices;
-                if (lobes.smooth > 0)
+                if (lobes.smooth > 0) {
+                    const guiding::GuidingField::Choice choice =
+                        guide_.learnLights ? guide.choice() : guiding::GuidingField::Choice();
                     s.L += s.beta * sampleLight(si, bsdf, vertexGuide, sampler, stats,
-                                                media ? &s.pm : nullptr);
+                                                media ? &s.pm : nullptr, choice,
+                                                choice.learning ? &rec : nullptr, &guide);
+                    s.prevChoice = choice;
+                }
             }
             // Training: the previous guided vertex's Eq. 1 target, from the light found here.
             bool deferTarget;

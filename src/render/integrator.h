@@ -63,6 +63,9 @@ struct GuideSettings {
     // learned one.
     bool learnMix = false;
     bool learn = true;  // record training targets during rendering
+    // lights=learned (the field learns choices): next-event estimation picks lights with the
+    // region's learned choice mixed in (PathIntegrator::lightPmf).
+    bool learnLights = false;
     // learn=N (render loop): the guide learns during the first N samples per pixel only; the
     // passes after them sample from the guide as it is then, without recording targets or
     // updating it between passes (no learning work; the image stays consistent, as with any
@@ -201,9 +204,28 @@ private:
         int medium = -1;
         Rng* rng = nullptr;
     };
+    // choice: the vertex's learned light choice (GuidingField::choiceCdf) or nullptr; with
+    // rec, what the shadow ray found is recorded for the region of `region` (learned choices).
     Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, GuideMixture& guide,
-                         Sampler& sampler, PathStats& stats,
-                         const PathMedium* media = nullptr) const;
+                         Sampler& sampler, PathStats& stats, const PathMedium* media = nullptr,
+                         const guiding::GuidingField::Choice& choice = {},
+                         PathRecorder* rec = nullptr,
+                         const guiding::VertexGuide* region = nullptr) const;
+    // The probability that next-event estimation at p picks `light`: the scene's light
+    // sampler's, mixed with the learned choice where there is one (choiceShare of it).
+    float lightPmf(const Vec3& p, const guiding::GuidingField::Choice& choice, int light) const {
+        return lightChoice(choice).pmf(p, light);
+    }
+    MixedLightChoice lightChoice(const guiding::GuidingField::Choice& c) const {
+        return MixedLightChoice{*lights_, c.cdf, int(scene_.lights.size()), choiceShare(c)};
+    }
+    // The learned light choice's share of the selection: up to kChoiceShare as the region's
+    // records grow (its weight); the rest stays with the scene's light sampler, so a light
+    // the region has not seen lit keeps its chance (and the estimate stays unbiased).
+    static constexpr float kChoiceShare = 0.8f;
+    static float choiceShare(const guiding::GuidingField::Choice& c) {
+        return kChoiceShare * c.weight;
+    }
     // Next-event estimation at a medium vertex (phase function pbrt-v3 HG with g), MIS
     // against the vertex's direction sampling (phase, or the guide mixed with it at a region).
     Spectrum sampleLightMedium(const Vec3& p, const Vec3& wo, float g, GuideMixture& guide,
@@ -224,6 +246,10 @@ private:
         bool specularBounce = false;
         float dirPdf = 0.f, etaScale = 1.f;
         LightSampleContext prev;
+        // The learned light choice (GuidingField::choiceCdf) that the previous vertex's
+        // next-event estimation used, for the MIS weight of emission found from there; nullptr:
+        // the scene's light sampler alone.
+        guiding::GuidingField::Choice prevChoice;
         PathMedium pm;
         GuideClockSums* clock = nullptr;  // the guide clock of a timed path (render/guide_clock.h)
     };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "guiding/directional.h"
 #include "util/sequence.h"
 
 namespace rlpbrt {
@@ -148,6 +149,19 @@ int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf) const {
 
 float SpatialLightSampler::pmf(const Vec3& p, int light) const {
     return lookup(p)[lights_.size() + 1 + size_t(light)];
+}
+
+int MixedLightChoice::sample(const Vec3& p, float u, float* pmfOut) const {
+    if (!cdf || !(share > 0.f)) return base.sample(p, u, pmfOut);
+    float known = -1.f;
+    int light;
+    if (u < share) {
+        light = guiding::sampleStrataCdf(cdf, n, std::min(u / share, OneMinusEpsilon));
+    } else {
+        light = base.sample(p, std::min((u - share) / (1.f - share), OneMinusEpsilon), &known);
+    }
+    *pmfOut = light >= 0 ? pmf(p, light, known) : 0.f;
+    return *pmfOut > 0.f ? light : -1;
 }
 
 std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,

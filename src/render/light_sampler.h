@@ -35,6 +35,27 @@ std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,
                                                  const Vec3& boundsMin, const Vec3& boundsMax,
                                                  std::string* note, bool media = false);
 
+// A learned light choice mixed into a light sampler (guide parameter lights=learned): with
+// probability `share` a light is drawn from `cdf` (n + 1 floats over the n lights: a region's
+// learned choice, GuidingField::choice), else from `base`. The mixture's pmf is
+// share * (cdf[l+1] - cdf[l]) + (1 - share) * base.pmf: every light the base sampler can pick
+// keeps a chance, so next-event estimation stays unbiased whatever the learned CDF says.
+// cdf null or share 0: the base sampler alone.
+struct MixedLightChoice {
+    const LightSampler& base;
+    const float* cdf;
+    int n;
+    float share;
+    // A light for the receiving point p from u in [0,1), with its pmf; -1 (pmf 0) for none.
+    int sample(const Vec3& p, float u, float* pmf) const;
+    // The pmf of `light` at p; baseKnown >= 0: base.pmf(p, light), already looked up.
+    float pmf(const Vec3& p, int light, float baseKnown = -1.f) const {
+        if (!(baseKnown >= 0.f)) baseKnown = base.pmf(p, light);
+        if (!cdf || !(share > 0.f)) return baseKnown;
+        return share * (cdf[light + 1] - cdf[light]) + (1.f - share) * baseKnown;
+    }
+};
+
 // The "spatial" strategy, exposed for tests.
 class SpatialLightSampler : public LightSampler {
 public:

@@ -124,6 +124,8 @@ void recordSlot(GuidingField& f, int pass, int s) {
             const glm::vec3 spot = i % 2 ? glm::vec3(0.3f, 0.8f, 2.f) : glm::vec3(-1.f, 0.2f, 1.5f);
             const glm::vec3 hit = spot + 0.01f * glm::vec3(u(rng), u(rng), u(rng));
             f.recordSpot(s, region, p, glm::normalize(hit - p), hit, 1e4f + target());
+            // A light choice (fields that learn choices; others ignore it).
+            f.recordChoice(s, region, i % 3, i % 3 == 1 ? 0.f : target());
         }
         const glm::vec3 q(u(rng), u(rng), 0.5f * u(rng));
         const int cell = f.lookupMedium(q);
@@ -150,6 +152,11 @@ void expectSameField(const GuidingField& a, const GuidingField& b, int regions) 
     int mismatches = 0;
     for (int r = 0; r < regions; ++r) {
         mismatches += a.confidence(r) != b.confidence(r);
+        const GuidingField::Choice ca = a.choice(r), cb = b.choice(r);
+        mismatches += ca.weight != cb.weight || ca.learning != cb.learning ||
+                      (ca.cdf == nullptr) != (cb.cdf == nullptr);
+        if (ca.cdf && cb.cdf)
+            for (int k = 0; k <= 3; ++k) mismatches += ca.cdf[k] != cb.cdf[k];
         mismatches += a.selection(r) != b.selection(r);
         for (const glm::vec3& w : dirs) {
             mismatches += a.pdf(r, w) != b.pdf(r, w);
@@ -172,13 +179,18 @@ template <class Field>
 void checkShared(const char* backend, const SceneInfo& scene,
                  std::map<std::string, std::string> params,
                  const std::function<int(const Field&)>& regions, bool narrowCounts = true,
-                 const std::function<void(const Field&)>& checkOne = nullptr) {
+                 const std::function<void(const Field&)>& checkOne = nullptr,
+                 int choices = 0) {
     constexpr int kRanks = 3, kPasses = 3;
     auto one = test::makeField<Field>(backend, scene, params);
     std::vector<std::unique_ptr<Field>> ranks;
     for (int k = 0; k < kRanks; ++k)
         ranks.push_back(test::makeField<Field>(backend, scene, params));
     ASSERT_TRUE(one);
+    if (choices > 0) {
+        ASSERT_TRUE(one->enableChoices(choices));
+        for (auto& f : ranks) ASSERT_TRUE(f->enableChoices(choices));
+    }
     ThreadSum<double> sum(kRanks);
     ThreadSum<uint32_t> counts(kRanks);
     ThreadGather gather(kRanks);
@@ -228,6 +240,19 @@ TEST(SharedPass, HemiRanksLearnTheSpotLobesOfOneProcess) {
         [](const HemiField& f) { return f.numRegions(); }, true, [](const HemiField& f) {
             EXPECT_GT(f.spots()->activeLobes(), 1u);
         });
+}
+
+// Learned light choices (enableChoices): every rank's records in every region's means.
+TEST(SharedPass, HemiRanksLearnTheChoicesOfOneProcess) {
+    checkShared<HemiField>(
+        "hemi", test::cornerScene(), {{"points", "8"}},
+        [](const HemiField& f) { return f.numRegions(); }, true,
+        [](const HemiField& f) {
+            int learned = 0;
+            for (int r = 0; r < f.numRegions(); ++r) learned += f.choice(r).cdf != nullptr;
+            EXPECT_GT(learned, 0);
+        },
+        3);
 }
 
 TEST(SharedPass, CountsAsDoublesGiveTheSameField) {
