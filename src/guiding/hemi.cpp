@@ -609,6 +609,17 @@ std::string HemiField::describe() const {
                       spots_->activeLobes(), spots_->activeRegions());
         line += buf;
     }
+    if (choices_) {
+        size_t used = 0, full = 0;
+        for (size_t r = 0; r < choiceWeight_.size(); ++r) {
+            used += choiceWeight_[r] > 0.f;
+            full += choiceWeight_[r] >= kChoiceFullWeight;
+        }
+        std::snprintf(buf, sizeof(buf),
+                      "; lights=learned (%d lights): used in %zu hemispheres, done learning in %zu",
+                      choices_->strata(), used, full);
+        line += buf;
+    }
     if (numPatches_ > 0) {
         std::snprintf(buf, sizeof(buf), "; %u surface patches", numPatches_);
         line += buf;

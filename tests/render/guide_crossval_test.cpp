@@ -165,8 +165,10 @@ TEST(GuideCrossValidation, GuidedPassesContinueThePixelSequence) {
     const std::string scene = test::sharedDir() + "/scenes/cornell-box/scene.small.pbrt";
     const int spp = 16;
     Rendered none = renderWith(scene, "none", spp);
-    Rendered seq = renderWith(scene, "hemi", spp, {{"mix", "0"}});
-    Rendered own = renderWith(scene, "hemi", spp, {{"mix", "0"}, {"samples", "independent"}});
+    // (lights=scene: the learned light choice would change next-event estimation.)
+    Rendered seq = renderWith(scene, "hemi", spp, {{"mix", "0"}, {"lights", "scene"}});
+    Rendered own = renderWith(scene, "hemi", spp,
+                              {{"mix", "0"}, {"lights", "scene"}, {"samples", "independent"}});
     ASSERT_FALSE(none.image.empty());
     EXPECT_GT(seq.stats.records, 0u);
     auto relDiff = [&](const Image& a) {
@@ -186,7 +188,8 @@ TEST(GuideCrossValidation, GuidedPassesContinueThePixelSequence) {
     // with mix=0 the guided passes sample as plain ones do, so guided and plain cost the same
     // per sample up to the learning, the trial runs (at 4 spp: guided pass 4..6, plain pass
     // 6..8) and the image still equals the plain render, whatever its verdict.
-    Rendered trial = renderWith(scene, "hemi", spp, {{"mix", "0"}, {"auto", "4"}});
+    Rendered trial =
+        renderWith(scene, "hemi", spp, {{"mix", "0"}, {"lights", "scene"}, {"auto", "4"}});
     EXPECT_TRUE(trial.autoTrial.ran);
     EXPECT_GT(trial.autoTrial.guidedCost, 0.0);
     EXPECT_GT(trial.autoTrial.plainCost, 0.0);
