@@ -236,10 +236,10 @@ private:
 
     bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
     const float* cdf(int region) const { return table_.cdf(size_t(region)); }
-    // Rebuilds a region's CDF, then its moment and confidence (called per updated region,
-    // concurrently for distinct regions).
     // The learned choices' policy (their CDF proportional to the means).
     StrataTable::PolicyBuilder choicesPolicy() const;
+    // Rebuilds a region's CDF, then its moment and confidence (called per updated region,
+    // concurrently for distinct regions).
     StrataTable::PolicyBuilder policy() {
         return [this](int region, const double* q, float* c) {
             buildPolicy(q, c);

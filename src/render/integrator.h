@@ -204,8 +204,8 @@ private:
         int medium = -1;
         Rng* rng = nullptr;
     };
-    // choice: the vertex's learned light choice (GuidingField::choiceCdf) or nullptr; with
-    // rec, what the shadow ray found is recorded for the region of `region` (learned choices).
+    // choice: the vertex's learned light choice (GuidingField::choice; none: the scene's
+    // light sampler alone); with rec, what the shadow ray found is recorded for `region`.
     Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, GuideMixture& guide,
                          Sampler& sampler, PathStats& stats, const PathMedium* media = nullptr,
                          const guiding::GuidingField::Choice& choice = {},
@@ -246,8 +246,8 @@ private:
         bool specularBounce = false;
         float dirPdf = 0.f, etaScale = 1.f;
         LightSampleContext prev;
-        // The learned light choice (GuidingField::choiceCdf) that the previous vertex's
-        // next-event estimation used, for the MIS weight of emission found from there; nullptr:
+        // The learned light choice (GuidingField::choice) that the previous vertex's
+        // next-event estimation used, for the MIS weight of emission found from there; none:
         // the scene's light sampler alone.
         guiding::GuidingField::Choice prevChoice;
         PathMedium pm;
