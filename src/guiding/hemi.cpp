@@ -216,7 +216,8 @@ int HemiField::prefetched(int region) const {
     if (spots_) spots_->prefetch(region);
     if (choices_) {  // the learned light choice, read by the vertex's next-event estimation
         prefetchLine(&choiceWeight_[size_t(region)]);
-        prefetchLines(choices_->cdf(size_t(region)), size_t(choices_->strata() + 1) * sizeof(float));
+        prefetchLines(choices_->cdf(size_t(region)),
+                      size_t(choices_->strata() + 1) * sizeof(float));
     }
     prefetchLines(cdf(region), size_t(strata_ + 1) * sizeof(float));
     // And its estimates where the integrator reads them at every vertex (Eq. 1's bootstrap
@@ -417,12 +418,7 @@ void choicePolicy(int, const double* q, int n, float* cdf) { buildStrataCdf(q, n
 bool HemiField::enableChoices(int n) {
     if (n < 2 || n > kMaxChoices) return false;
     choices_ = std::make_unique<StrataTable>();
-    const int options = n;
-    choices_->reset(size_t(numRegions()), n, 0.0,
-                    [options](int r, const double* q, float* cdf) {
-                        choicePolicy(r, q, options, cdf);
-                    },
-                    /*lazy=*/true);
+    choices_->reset(size_t(numRegions()), n, 0.0, choicesPolicy(n), /*lazy=*/true);
     choiceWeight_.assign(size_t(numRegions()), 0.f);
     return true;
 }
@@ -439,8 +435,7 @@ void HemiField::recordChoice(int slot, int region, int k, float value) {
     choices_->record(slot, region, value, [k] { return k; });
 }
 
-StrataTable::PolicyBuilder HemiField::choicesPolicy() const {
-    const int n = choices_ ? choices_->strata() : 0;
+StrataTable::PolicyBuilder HemiField::choicesPolicy(int n) {
     return [n](int r, const double* q, float* cdf) { choicePolicy(r, q, n, cdf); };
 }
 
@@ -511,7 +506,7 @@ double HemiField::learnedTotal(size_t region) const {
 void HemiField::endPass() {
     table_.endPass(params_.alphaVisits, params_.fixedAlpha, policy());
     if (choices_) {
-        choices_->endPass(/*alphaVisits=*/true, 0.0, choicesPolicy());
+        choices_->endPass(/*alphaVisits=*/true, 0.0, choicesPolicy(choices_->strata()));
         updateChoiceWeights();
     }
     if (spots_) spots_->endPass(learnedTotals());
@@ -544,7 +539,8 @@ void HemiField::updateTreeRegions() {
 void HemiField::endPassShared(const SumAcrossProcesses& sum) {
     table_.endPassShared(params_.alphaVisits, params_.fixedAlpha, policy(), sum);
     if (choices_) {
-        choices_->endPassShared(/*alphaVisits=*/true, 0.0, choicesPolicy(), sum);
+        choices_->endPassShared(/*alphaVisits=*/true, 0.0, choicesPolicy(choices_->strata()),
+                                sum);
         updateChoiceWeights();
     }
     if (spots_) {
@@ -559,7 +555,8 @@ void HemiField::endPassShared(const SumAcrossProcesses& sum) {
 
 size_t HemiField::bytes() const {
     return table_.bytes() + (trees_ ? trees_->bytes() : 0) + (spots_ ? spots_->bytes() : 0) +
-           (choices_ ? choices_->bytes() : 0) + (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
+           (choices_ ? choices_->bytes() : 0) +
+           (positions_.capacity() + normals_.capacity()) * sizeof(glm::vec3) +
            frames_.capacity() * sizeof(RegionFrame) + tree_->bytes() +
            (cache_ ? cache_->bytes() : 0) + size_t(numPatches_) * sizeof(uint32_t);
 }
@@ -616,7 +613,8 @@ std::string HemiField::describe() const {
             full += choiceWeight_[r] >= kChoiceFullWeight;
         }
         std::snprintf(buf, sizeof(buf),
-                      "; lights=learned (%d lights): used in %zu hemispheres, done learning in %zu",
+                      "; lights=learned (%d lights): used in %zu hemispheres, done learning "
+                      "in %zu",
                       choices_->strata(), used, full);
         line += buf;
     }
@@ -800,7 +798,8 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
         if (choiceQ.empty()) {
             enableChoices(choices_->strata());
         } else {
-            choices_->assign(std::move(choiceQ), std::move(choiceVisits), choicesPolicy());
+            choices_->assign(std::move(choiceQ), std::move(choiceVisits),
+                             choicesPolicy(choices_->strata()));
             updateChoiceWeights();
         }
     }

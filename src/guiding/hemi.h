@@ -236,8 +236,8 @@ private:
 
     bool validRegion(int region) const { return region >= 0 && region < numRegions(); }
     const float* cdf(int region) const { return table_.cdf(size_t(region)); }
-    // The learned choices' policy (their CDF proportional to the means).
-    StrataTable::PolicyBuilder choicesPolicy() const;
+    // The learned choices' policy for n options (their CDF proportional to the means).
+    static StrataTable::PolicyBuilder choicesPolicy(int n);
     // Rebuilds a region's CDF, then its moment and confidence (called per updated region,
     // concurrently for distinct regions).
     StrataTable::PolicyBuilder policy() {

@@ -125,8 +125,9 @@ TEST(HemiChoices, SavedStateRestoresTheChoices) {
         EXPECT_EQ(a.weight, b.weight);
         EXPECT_EQ(a.learning, b.learning);
         ASSERT_EQ(a.cdf == nullptr, b.cdf == nullptr) << r;
-        if (a.cdf)
+        if (a.cdf) {
             for (int k = 0; k <= 4; ++k) EXPECT_EQ(a.cdf[k], b.cdf[k]);
+        }
     }
     // Both learn on alike.
     for (HemiField* h : {f.get(), g.get()}) {
