@@ -6,7 +6,10 @@
 // render in this VM (its clock reads are slow: profiled on cornell-box), one in 128 costs
 // well under 1%, and the mean converges over the render's millions of paths. A timer's own
 // cost (two clock reads, tens of ns: as much as a pdf evaluation) is measured once
-// (timerOverheadNanos) and taken off per timed call.
+// (timerOverheadNanos) and taken off per timed call. A call that took longer than
+// kPreemptedNanos was descheduled (a guide call takes ns to us; the scheduler's slice is ms):
+// it is left out with its count, else one preemption among a small render's few timed paths
+// made the guide's share of the render exceed 1 on a loaded machine.
 #pragma once
 
 #include <chrono>
@@ -15,6 +18,7 @@
 namespace rlpbrt {
 
 constexpr uint64_t kGuideClockEvery = 128;
+constexpr uint64_t kPreemptedNanos = 200'000;
 
 // The time measured on timed paths, and the number of timed calls.
 struct GuideClockSums {
@@ -38,9 +42,11 @@ public:
     }
     ~GuideTimer() {
         if (!sums_) return;
-        sums_->nanos += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     std::chrono::steady_clock::now() - t0_)
-                                     .count());
+        const uint64_t ns = uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                         std::chrono::steady_clock::now() - t0_)
+                                         .count());
+        if (ns > kPreemptedNanos) return;
+        sums_->nanos += ns;
         ++sums_->calls;
     }
     GuideTimer(const GuideTimer&) = delete;

@@ -1,5 +1,6 @@
-// render/guide_clock.h: a timer adds its interval and one call; the calibrated overhead is
-// positive and small, and the guide's time never goes below zero.
+// render/guide_clock.h: a timer adds its interval and one call, and nothing for an interval
+// longer than kPreemptedNanos (a descheduled call); the calibrated overhead is positive and
+// small, and the guide's time never goes below zero.
 #include <chrono>
 #include <thread>
 
@@ -12,18 +13,30 @@ namespace {
 
 TEST(GuideClock, TimersAddTheirIntervalAndCount) {
     GuideClockSums sums;
-    {
+    // A 50 us call is counted (tried again if this thread was descheduled during it).
+    for (int attempt = 0; attempt < 10 && sums.calls == 0; ++attempt) {
         GuideTimer t(&sums);
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(50);
+        while (std::chrono::steady_clock::now() < until) {
+        }
     }
     { GuideTimer untimed(nullptr); }
     EXPECT_EQ(sums.calls, 1u);
-    EXPECT_GE(sums.nanos, 2000000u);
-    EXPECT_GE(sums.guideNanos(), 2000000.0 - timerOverheadNanos());
+    EXPECT_GE(sums.nanos, 50000u);
+    EXPECT_GE(sums.guideNanos(), 50000.0 - timerOverheadNanos());
+    // A call as long as a scheduler's slice was preempted: left out, time and count.
+    {
+        GuideTimer t(&sums);
+        std::this_thread::sleep_for(std::chrono::nanoseconds(2 * kPreemptedNanos));
+    }
+    EXPECT_EQ(sums.calls, 1u);
+    EXPECT_LT(sums.nanos, kPreemptedNanos);
+    const uint64_t nanos = sums.nanos;
     GuideClockSums more;
     more.nanos = 5, more.calls = 2;
     sums.add(more);
     EXPECT_EQ(sums.calls, 3u);
+    EXPECT_EQ(sums.nanos, nanos + 5u);
 }
 
 TEST(GuideClock, OverheadIsCalibratedAndTakenOff) {
