@@ -209,7 +209,7 @@ public:
     // answer with a distribution proportional to the means, frozen per pass like the policy.
     // Enables n options (2..kMaxChoices), before the first beginPass; false where the backend
     // does not learn choices (the default).
-    static constexpr int kMaxChoices = 16;
+    static constexpr int kMaxChoices = 64;
     virtual bool enableChoices(int n);
     // The learned distribution of `region`: a CDF of n + 1 floats (cdf[0] = 0, cdf[n] = 1)
     // and how far it is trusted (weight in (0, 1], growing with the region's records), or

@@ -613,7 +613,7 @@ std::string HemiField::describe() const {
             full += choiceWeight_[r] >= kChoiceFullWeight;
         }
         std::snprintf(buf, sizeof(buf),
-                      "; lights=learned (%d lights): used in %zu hemispheres, done learning "
+                      "; lights=learned (%d emitters): used in %zu hemispheres, done learning "
                       "in %zu",
                       choices_->strata(), used, full);
         line += buf;

@@ -153,11 +153,12 @@ bool setupGuiding(const Scene& scene, const guiding::GuideConfig& config,
     *field = guiding::createGuidingField(config, info, error);
     if (!*field) return false;
     settings->field = field->get();
-    // Learned light choices for scenes of a few lights (each region keeps a mean per light).
-    const size_t lights = scene.lights.size();
-    settings->learnLights = learnLights && lights >= 2 &&
-                            lights <= size_t(guiding::GuidingField::kMaxChoices) &&
-                            (*field)->enableChoices(int(lights));
+    // Learned light choices for scenes of a few emitters (each region keeps a mean per
+    // emitter: render/light_sampler.h, LightGroups).
+    const int emitters = scene.lightGroups.count();
+    settings->learnLights = learnLights && emitters >= 2 &&
+                            emitters <= guiding::GuidingField::kMaxChoices &&
+                            (*field)->enableChoices(emitters);
     const float patchSize = (*field)->patchSize();
     if (patchSize > 0.f) {
         // At most 2^24 patches (64 MiB of memo at most, in pages touched only where paths
@@ -277,10 +278,13 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     const int li = lightChoice(choice).sample(si.p, uLight, &pmf);
     if (li < 0 || pmf == 0.f) return Spectrum(0.f);
     // What the shadow ray found for the learned choice: Le f cos / pdf where the light is
-    // visible, 0 where not (before the selection's probability and the MIS weight).
+    // visible, 0 where not (before the selection's probability and the MIS weight), over the
+    // light's share of its emitter: an estimate of the whole emitter's.
     const bool learns = rec && region && region->valid();
     auto found = [&](float value) {
-        if (learns) rec->lightChosen(*region, li, value);
+        if (!learns) return;
+        const float within = scene_.lightGroups.within(li);
+        rec->lightChosen(*region, scene_.lightGroups.group(li), within > 0.f ? value / within : 0.f);
     };
     const Light& light = *scene_.lights[size_t(li)];
     LightSampleContext ctx{si.p, si.ng};

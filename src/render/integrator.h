@@ -217,7 +217,7 @@ private:
         return lightChoice(choice).pmf(p, light);
     }
     MixedLightChoice lightChoice(const guiding::GuidingField::Choice& c) const {
-        return MixedLightChoice{*lights_, c.cdf, int(scene_.lights.size()), choiceShare(c)};
+        return MixedLightChoice{*lights_, c.cdf, scene_.lightGroups, choiceShare(c)};
     }
     // The learned light choice's share of the selection: up to kChoiceShare as the region's
     // records grow (its weight); the rest stays with the scene's light sampler, so a light

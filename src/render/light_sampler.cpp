@@ -1,6 +1,8 @@
 #include "render/light_sampler.h"
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 #include "guiding/directional.h"
 #include "util/sequence.h"
@@ -151,12 +153,65 @@ float SpatialLightSampler::pmf(const Vec3& p, int light) const {
     return lookup(p)[lights_.size() + 1 + size_t(light)];
 }
 
+LightGroups::LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
+                         const std::vector<int>& emitter)
+    : group_(lights.size()), within_(lights.size()) {
+    // Groups numbered by their first light.
+    std::vector<std::pair<int, int>> byEmitter;  // (emitter, group)
+    std::vector<std::vector<int>> lightsOf;
+    for (size_t l = 0; l < lights.size(); ++l) {
+        const int e = emitter[l];
+        auto it = std::find_if(byEmitter.begin(), byEmitter.end(),
+                               [e](const std::pair<int, int>& x) { return x.first == e; });
+        int g;
+        if (it == byEmitter.end() || e < 0) {
+            g = int(lightsOf.size());
+            lightsOf.emplace_back();
+            if (e >= 0) byEmitter.emplace_back(e, g);
+        } else {
+            g = it->second;
+        }
+        group_[l] = g;
+        lightsOf[size_t(g)].push_back(int(l));
+    }
+    first_.push_back(0);
+    for (const std::vector<int>& ls : lightsOf) {
+        double total = 0.0;
+        for (int l : ls) {
+            const float w = luminance(lights[size_t(l)]->power());
+            total += std::isfinite(w) && w > 0.f ? w : 0.f;
+        }
+        double acc = 0.0;
+        for (int l : ls) {
+            const float w = luminance(lights[size_t(l)]->power());
+            const double q = total > 0.0 ? (std::isfinite(w) && w > 0.f ? w / total : 0.0)
+                                         : 1.0 / double(ls.size());
+            within_[size_t(l)] = float(q);
+            acc += q;
+            members_.push_back(l);
+            cdf_.push_back(float(acc));
+        }
+        cdf_.back() = 1.f;
+        first_.push_back(int(members_.size()));
+    }
+}
+
+int LightGroups::sample(int g, float u) const {
+    const int b = first_[size_t(g)], e = first_[size_t(g) + 1];
+    const auto it = std::upper_bound(cdf_.begin() + b, cdf_.begin() + e, u);
+    return members_[size_t(std::min(int(it - cdf_.begin()), e - 1))];
+}
+
 int MixedLightChoice::sample(const Vec3& p, float u, float* pmfOut) const {
     if (!cdf || !(share > 0.f)) return base.sample(p, u, pmfOut);
     float known = -1.f;
     int light;
     if (u < share) {
-        light = guiding::sampleStrataCdf(cdf, n, std::min(u / share, OneMinusEpsilon));
+        const float v = std::min(u / share, OneMinusEpsilon);
+        const int g = guiding::sampleStrataCdf(cdf, groups.count(), v);
+        const float width = cdf[g + 1] - cdf[g];
+        const float w = width > 0.f ? std::clamp((v - cdf[g]) / width, 0.f, OneMinusEpsilon) : 0.f;
+        light = groups.sample(g, w);
     } else {
         light = base.sample(p, std::min((u - share) / (1.f - share), OneMinusEpsilon), &known);
     }

@@ -35,16 +35,43 @@ std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,
                                                  const Vec3& boundsMin, const Vec3& boundsMax,
                                                  std::string* note, bool media = false);
 
+// The options of the learned light choice: lights grouped by emitter. The lights one
+// AreaLightSource makes on one shape (a mesh's triangles, as pbrt-v3 makes them) form one
+// group, every other light a group of its own; within a group a light is chosen in proportion
+// to its power. A group is what a region can see or not (one lamp), so the learned choice has
+// as many options as emitters: cornell-box's one quad is one group (nothing to learn), not
+// two triangles.
+class LightGroups {
+public:
+    LightGroups() = default;
+    // emitter[l]: light l's emitter id (lights of one emitter are contiguous or not; ids any
+    // ints); lights and emitter have the same size.
+    LightGroups(const std::vector<std::unique_ptr<Light>>& lights, const std::vector<int>& emitter);
+    int count() const { return first_.empty() ? 0 : int(first_.size()) - 1; }
+    int group(int light) const { return group_[size_t(light)]; }
+    // The probability of `light` among its group's lights.
+    float within(int light) const { return within_[size_t(light)]; }
+    // A light of group g from u in [0,1), with probability within().
+    int sample(int g, float u) const;
+
+private:
+    std::vector<int> group_;       // per light
+    std::vector<float> within_;    // per light
+    std::vector<int> first_;       // per group + 1: its range in members_ / cdf_
+    std::vector<int> members_;     // lights by group
+    std::vector<float> cdf_;       // per member: the within-group CDF after it
+};
+
 // A learned light choice mixed into a light sampler (guide parameter lights=learned): with
-// probability `share` a light is drawn from `cdf` (n + 1 floats over the n lights: a region's
-// learned choice, GuidingField::choice), else from `base`. The mixture's pmf is
-// share * (cdf[l+1] - cdf[l]) + (1 - share) * base.pmf: every light the base sampler can pick
-// keeps a chance, so next-event estimation stays unbiased whatever the learned CDF says.
-// cdf null or share 0: the base sampler alone.
+// probability `share` a group is drawn from `cdf` (count() + 1 floats: a region's learned
+// choice, GuidingField::choice) and a light within it by power, else a light from `base`.
+// The mixture's pmf is share * (cdf[g+1] - cdf[g]) * within(l) + (1 - share) * base.pmf:
+// every light the base sampler can pick keeps a chance, so next-event estimation stays
+// unbiased whatever the learned CDF says. cdf null or share 0: the base sampler alone.
 struct MixedLightChoice {
     const LightSampler& base;
     const float* cdf;
-    int n;
+    const LightGroups& groups;
     float share;
     // A light for the receiving point p from u in [0,1), with its pmf; -1 (pmf 0) for none.
     int sample(const Vec3& p, float u, float* pmf) const;
@@ -52,7 +79,8 @@ struct MixedLightChoice {
     float pmf(const Vec3& p, int light, float baseKnown = -1.f) const {
         if (!(baseKnown >= 0.f)) baseKnown = base.pmf(p, light);
         if (!cdf || !(share > 0.f)) return baseKnown;
-        return share * (cdf[light + 1] - cdf[light]) + (1.f - share) * baseKnown;
+        const int g = groups.group(light);
+        return share * (cdf[g + 1] - cdf[g]) * groups.within(light) + (1.f - share) * baseKnown;
     }
 };
 

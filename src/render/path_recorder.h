@@ -142,10 +142,10 @@ public:
         spotPending_ = false;
         recordReturns(L, base);
     }
-    // Next-event estimation at the vertex of `guide` sent its shadow ray to `light` and found
-    // `value` (GuidingField::recordChoice; 0 where the light was hidden).
-    void lightChosen(const guiding::VertexGuide& guide, int light, float value) {
-        if (learn_) slot_.recordChoice(guide, light, value);
+    // Next-event estimation at the vertex of `guide` sent its shadow ray to a light of
+    // `group` (LightGroups) and found `value` (GuidingField::recordChoice; 0 where hidden).
+    void lightChosen(const guiding::VertexGuide& guide, int group, float value) {
+        if (learn_) slot_.recordChoice(guide, group, value);
     }
     // The path ended with radiance L: records the returns and the selection samples.
     void finish(const Spectrum& L);

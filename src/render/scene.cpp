@@ -709,6 +709,8 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
     SceneAssembler as(s, diag);
     as.makeDevice();
     s.groups_.resize(1 + desc.objects.size());
+    std::vector<int> emitterOf;  // per light: its area-light shape, -1 for a LightSource
+    int emitters = 0;
     auto addPrim = [&](int shapeIndex, PrimitiveGroup& group, bool allowLights) {
         const ShapeEntity& e = desc.shapes[size_t(shapeIndex)];
         Primitive prim;
@@ -727,6 +729,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
                 prim.lightBase = int(s.lights.size());
                 s.stats.areaLights += made.size();
                 for (auto& l : made) s.lights.push_back(std::move(l));
+                emitterOf.resize(s.lights.size(), emitters++);
             }
         }
         s.stats.shapes++;
@@ -795,6 +798,8 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc, const BuildOptions& opt
     Vec3 center = 0.5f * (s.bMin_ + s.bMax_);
     float radius = 0.5f * glm::length(s.bMax_ - s.bMin_);
     for (auto& l : s.lights) l->preprocess(center, radius);
+    emitterOf.resize(s.lights.size(), -1);
+    s.lightGroups = LightGroups(s.lights, emitterOf);
     s.stats.lights = s.lights.size();
     if (s.lights.empty())
         diag.warning(FileLoc{}, "the scene has no lights: the image will be black");

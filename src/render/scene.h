@@ -13,6 +13,7 @@
 #include "render/distribution.h"
 #include "render/film.h"
 #include "render/interaction.h"
+#include "render/light_sampler.h"
 #include "render/lights.h"
 #include "render/materials.h"
 #include "render/ray.h"
@@ -97,6 +98,9 @@ public:
     std::vector<std::unique_ptr<Material>> materials;
     std::vector<std::unique_ptr<Light>> lights;
     std::vector<int> infiniteLights;  // indices into lights
+    // The lights by emitter (one area-light shape's triangles are one group): the options of
+    // the learned light choice (render/light_sampler.h).
+    LightGroups lightGroups;
     // Participating media (empty unless the scene has media and its Integrator handles them,
     // as pbrt-v3's volpath does; `path` ignores media as in pbrt-v3). Surfaces whose two
     // media differ are medium boundaries; rays start in cameraMedium.
