@@ -545,7 +545,13 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
         bool learnsReturn;
     };
     constexpr int kMaxBranches = 32;
-    Branch branches[kMaxBranches];
+    // Left uninitialised (every field is set when a branch is pushed): value-initialising the
+    // 32 branches (6 KB) took 4% of every render's time, guided or not (killeroo, perf).
+    union BranchStack {
+        BranchStack() {}
+        Branch v[kMaxBranches];
+    } stack;
+    Branch* const branches = stack.v;
     int numBranches = 0, startBounces = 0;
     int branchesLeft = kMaxBranches;  // per camera path: its work stays bounded
     for (;;) {
