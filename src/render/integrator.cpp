@@ -284,7 +284,8 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
     auto found = [&](float value) {
         if (!learns) return;
         const float within = scene_.lightGroups.within(li);
-        rec->lightChosen(*region, scene_.lightGroups.group(li), within > 0.f ? value / within : 0.f);
+        rec->lightChosen(*region, scene_.lightGroups.group(li),
+                         within > 0.f ? value / within : 0.f);
     };
     const Light& light = *scene_.lights[size_t(li)];
     LightSampleContext ctx{si.p, si.ng};

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
+#include <unordered_map>
 
 #include "guiding/directional.h"
 #include "util/sequence.h"
@@ -157,20 +157,13 @@ LightGroups::LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
                          const std::vector<int>& emitter)
     : group_(lights.size()), within_(lights.size()) {
     // Groups numbered by their first light.
-    std::vector<std::pair<int, int>> byEmitter;  // (emitter, group)
+    std::unordered_map<int, int> groupOf;  // emitter -> group
     std::vector<std::vector<int>> lightsOf;
     for (size_t l = 0; l < lights.size(); ++l) {
         const int e = emitter[l];
-        auto it = std::find_if(byEmitter.begin(), byEmitter.end(),
-                               [e](const std::pair<int, int>& x) { return x.first == e; });
-        int g;
-        if (it == byEmitter.end() || e < 0) {
-            g = int(lightsOf.size());
-            lightsOf.emplace_back();
-            if (e >= 0) byEmitter.emplace_back(e, g);
-        } else {
-            g = it->second;
-        }
+        int g = int(lightsOf.size());
+        if (e >= 0) g = groupOf.emplace(e, g).first->second;  // the emitter's, or a new one
+        if (g == int(lightsOf.size())) lightsOf.emplace_back();
         group_[l] = g;
         lightsOf[size_t(g)].push_back(int(l));
     }

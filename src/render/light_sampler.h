@@ -46,7 +46,8 @@ public:
     LightGroups() = default;
     // emitter[l]: light l's emitter id (lights of one emitter are contiguous or not; ids any
     // ints); lights and emitter have the same size.
-    LightGroups(const std::vector<std::unique_ptr<Light>>& lights, const std::vector<int>& emitter);
+    LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
+                const std::vector<int>& emitter);
     int count() const { return first_.empty() ? 0 : int(first_.size()) - 1; }
     int group(int light) const { return group_[size_t(light)]; }
     // The probability of `light` among its group's lights.

@@ -76,7 +76,8 @@ void expectMixtureSamplesItsPmf(const LightSampler& base, const LightGroups& gro
             for (const Vec3 p : {Vec3(-1.f, 0.f, 0.f), Vec3(1.f, 0.f, 0.f)}) {
                 const MixedLightChoice mix{base, c, groups, share};
                 double total = 0.0;
-                std::vector<double> expected(static_cast<size_t>(n)), observed(expected.size(), 0.0);
+                std::vector<double> expected(static_cast<size_t>(n));
+                std::vector<double> observed(expected.size(), 0.0);
                 for (int l = 0; l < n; ++l) {
                     const float q = mix.pmf(p, l);
                     EXPECT_GT(q, 0.f) << l;  // every light keeps a chance
