@@ -30,7 +30,7 @@ void recordPass(HemiField& f, int r, const std::vector<float>& means, int perOpt
     f.endPass();
 }
 
-TEST(HemiChoices, OnlyForTwoToSixteenOptions) {
+TEST(HemiChoices, OnlyForTwoToMaxChoicesOptions) {
     auto f = makeHemi();
     EXPECT_FALSE(f->enableChoices(1));
     EXPECT_FALSE(f->enableChoices(GuidingField::kMaxChoices + 1));

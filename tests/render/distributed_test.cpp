@@ -46,8 +46,9 @@ std::string tempDir() {
     return mkdtemp(tmpl) ? tmpl : "/tmp";
 }
 
-// A 40x40 box room lit by a quad (3x3 sample tiles of 16 pixels, so both ranks render several);
-// `fog` fills it with a scattering medium (the vdb backend's volume tables then learn too).
+// A 40x40 box room lit by a quad and a dim point light (3x3 sample tiles of 16 pixels, so both
+// ranks render several); `fog` fills it with a scattering medium (the vdb backend's volume
+// tables then learn too).
 std::string writeRoom(const std::string& path, bool fog) {
     std::ofstream f(path);
     if (fog)
@@ -61,6 +62,8 @@ std::string writeRoom(const std::string& path, bool fog) {
          "AttributeBegin\n  AreaLightSource \"diffuse\" \"rgb L\" [8 8 8]\n"
          "  Shape \"trianglemesh\" \"point P\" [-0.2 0.99 -0.2  0.2 0.99 -0.2  0.2 0.99 0.2  "
          "-0.2 0.99 0.2] \"integer indices\" [0 1 2 0 2 3]\nAttributeEnd\n"
+         // A second emitter: hemi's learned light choice is summed across ranks too.
+         "LightSource \"point\" \"point from\" [0.6 0.3 0.4] \"rgb I\" [0.2 0.2 0.2]\n"
          "Material \"matte\"\n";
     if (fog) f << "MediumInterface \"fog\" \"\"\n";
     f << "Shape \"trianglemesh\" \"point P\" [-1 0 -1  1 0 -1  1 0 1  -1 0 1  -1 1 -1  "
@@ -135,6 +138,10 @@ TEST_P(TwoRanks, EqualOneProcess) {
     const std::string stats = slurp(dir + "/two.json");
     EXPECT_NE(stats.find("\"ranks\": 2"), std::string::npos) << stats;
     EXPECT_EQ(stats.find("\"bytes_exchanged\": 0,"), std::string::npos) << stats;
+    // hemi's ranks learn the choice between the room's two emitters together.
+    if (hemi) {
+        EXPECT_NE(stats.find("lights=learned (2 emitters)"), std::string::npos) << stats;
+    }
     // The time in the collectives, and the part of it spent waiting for the other rank.
     const double exchange = jsonNumber(stats, "\"exchange_seconds\"");
     const double waiting = jsonNumber(stats, "\"exchange_wait_seconds\"");
