@@ -118,12 +118,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     const bool timed = options.timeBudget > 0.0;
     // Passes: plain path tracing takes one sample per pixel per pass from one sequence per
     // pixel. A guided render learns between passes, with passes sized half the samples so far
-    // (1, 1, 1, 1, 2, 3, 4, 6, 9, ...; at most 64): frequent updates early. Its samples
-    // continue the same sequence per pixel, or (samples=independent, GuideSettings::
-    // independentPasses) come from a set of the pass's own (Sampler::passSampler).
+    // (1, 1, 1, 1, 2, 3, 4, 6, 9, ...; at most 64, and fewer for a large image: below):
+    // frequent updates early. Its samples continue the same sequence per pixel, or
+    // (samples=independent, GuideSettings::independentPasses) come from a set of the pass's
+    // own (Sampler::passSampler).
     // Halves learned better than doubling pass sizes (docs/BENCHMARKS_HISTORY.md).
     bool guided = field != nullptr;
-    constexpr int kMaxGuidedPass = 64;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
     // that reaches autoSpp (or a quarter of a time budget) is measured, then a plain pass of the same size; the rest is
     // rendered plain if the guided pass cost more than kAutoMargin times the plain one per
@@ -135,6 +135,16 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // trial is not distributed yet (the command line refuses auto=N on several ranks).
     Ranks* const ranks = options.ranks;
     if (ranks) trial = Trial::Done;
+    // A pass's training records wait in memory until it ends (about 110 bytes per camera
+    // path on cornell-box): a pass also takes at most options.maxPassPaths paths per process
+    // (4M: about 0.45 GB), so a large image takes fewer samples per pass. Without it a
+    // 400x400 cornell-box held 1.2 GB of records at 64 spp per pass (0.44 GB with it, at 25
+    // spp, in the same time); a 1920x1080 image would hold 15 GB. Each of several ranks traces
+    // its share of the pixels (the same cap on every rank: they render the same passes).
+    const long long pixelsPerProcess =
+        std::max<long long>(1, film.sampleBounds().area() / (ranks ? ranks->size() : 1));
+    const int maxGuidedPass = int(std::clamp<long long>(
+        std::max(options.maxPassPaths, 1ll) / pixelsPerProcess, 1, 64));
     std::unique_ptr<PathIntegrator> plainIntegrator;
     std::unique_ptr<PassMoments> guidedMoments, plainMoments;
     // The pixel means of the passes before the trial: the trial's reference values.
@@ -237,7 +247,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         return s;
     };
     for (;;) {
-        int count = guided ? std::clamp(result.spp / 2, 1, kMaxGuidedPass) : 1;
+        int count = guided ? std::clamp(result.spp / 2, 1, maxGuidedPass) : 1;
         if (trial == Trial::MeasurePlain) count = guidedCount;
         if (!timed) {
             count = std::min(count, totalSpp - result.spp);

@@ -20,6 +20,11 @@ struct RenderOptions {
     bool progress = false;       // progress bar on stderr
     const std::atomic<bool>* cancel = nullptr;  // set to stop after the current pass
     GuideSettings guide;         // guiding field (null = plain path tracing) and mixture
+    // A guided pass takes at most this many camera paths per process (its share of the
+    // image's pixels times the pass's samples per pixel, at least one sample per pixel): its
+    // training records are buffered until the pass ends, about 110 bytes per path
+    // (render.cpp, the passes).
+    long long maxPassPaths = 1ll << 22;
     // Called after each pass with the image so far (for curves and checkpoints).
     std::function<void(int spp, double seconds, const Film& film)> onPass;
     // The ranks of a distributed render (null: this process renders alone). Each rank

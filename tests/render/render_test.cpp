@@ -1,6 +1,12 @@
 // End-to-end properties of the render loop on small scenes written here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "guiding/guiding.h"
 #include "parser/diagnostics.h"
 #include "render/render.h"
 #include "render/scene.h"
@@ -76,6 +82,44 @@ TEST(Render, TimeBudgetRendersWholePasses) {
     bool finite = true;
     for (float v : r.image.pixels) finite &= std::isfinite(v);
     EXPECT_TRUE(finite);
+}
+
+// A guided render's passes grow with the samples so far (half of them, at most 64 spp) and
+// take at most maxPassPaths camera paths, one sample per pixel at the least: the training
+// records of a large image's pass stay within memory. A plain render takes one per pass.
+TEST(Render, GuidedPassesStayWithinTheirPathBudget) {
+    constexpr int kSpp = 64;  // a power of two, as the sobol sampler rounds to
+    auto scene = build(kBox, kSpp, 0);
+    const long long pixels = Film(scene->filmParams, scene->filter).sampleBounds().area();
+    // The samples each pass added, for a pass budget of `budget` paths (0: the default).
+    auto passSizes = [&](const char* guide, long long budget) {
+        guiding::GuideConfig gc;
+        gc.backend = guide;
+        std::unique_ptr<guiding::GuidingField> field;
+        RenderOptions ro;
+        std::string err;
+        EXPECT_TRUE(setupGuiding(*scene, gc, &field, &ro.guide, &err)) << err;
+        ro.nThreads = 1;
+        if (budget > 0) ro.maxPassPaths = budget;
+        std::vector<int> sizes;
+        int before = 0;
+        ro.onPass = [&](int spp, double, const Film&) {
+            sizes.push_back(spp - before);
+            before = spp;
+        };
+        const RenderResult r = render(*scene, ro);
+        EXPECT_EQ(r.spp, kSpp);
+        EXPECT_EQ(r.passes, int(sizes.size()));
+        return sizes;
+    };
+    // Halves of the samples so far: 1, 1, 1, 1, 2, 3, 4, 6, 9, 14, 21, then the 1 left.
+    EXPECT_EQ(passSizes("hemi", 0), (std::vector<int>{1, 1, 1, 1, 2, 3, 4, 6, 9, 14, 21, 1}));
+    // A budget of 3 samples per pixel (and a bit): no pass above 3.
+    const std::vector<int> three = passSizes("hemi", 3 * pixels + pixels / 2);
+    EXPECT_EQ(*std::max_element(three.begin(), three.end()), 3);
+    // Below one sample per pixel: one per pass, as a plain render.
+    EXPECT_EQ(passSizes("hemi", pixels / 2), std::vector<int>(kSpp, 1));
+    EXPECT_EQ(passSizes("none", 0), std::vector<int>(kSpp, 1));
 }
 
 // A cancel flag set before rendering stops after the first pass with that pass's image.
