@@ -19,6 +19,13 @@ float haltonCoordinate(int baseIndex, uint32_t i) {
     return radicalInverse(i, primes[baseIndex]);
 }
 
+// A light's weight for power-proportional selection: the luminance of its power, 0 where
+// that is not a positive finite number.
+float powerWeight(const Light& light) {
+    const float w = luminance(light.power());
+    return std::isfinite(w) && w > 0.f ? w : 0.f;
+}
+
 class TableLightSampler : public LightSampler {
 public:
     explicit TableLightSampler(const std::vector<float>& w) : dist_(w) {}
@@ -155,7 +162,7 @@ float SpatialLightSampler::pmf(const Vec3& p, int light) const {
 
 LightGroups::LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
                          const std::vector<int>& emitter)
-    : group_(lights.size()), within_(lights.size()) {
+    : of_(lights.size()) {
     // Groups numbered by their first light.
     std::unordered_map<int, int> groupOf;  // emitter -> group
     std::vector<std::vector<int>> lightsOf;
@@ -164,22 +171,19 @@ LightGroups::LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
         int g = int(lightsOf.size());
         if (e >= 0) g = groupOf.emplace(e, g).first->second;  // the emitter's, or a new one
         if (g == int(lightsOf.size())) lightsOf.emplace_back();
-        group_[l] = g;
+        of_[l].group = g;
         lightsOf[size_t(g)].push_back(int(l));
     }
     first_.push_back(0);
+    std::vector<float> weight(lights.size());
+    for (size_t l = 0; l < lights.size(); ++l) weight[l] = powerWeight(*lights[l]);
     for (const std::vector<int>& ls : lightsOf) {
         double total = 0.0;
-        for (int l : ls) {
-            const float w = luminance(lights[size_t(l)]->power());
-            total += std::isfinite(w) && w > 0.f ? w : 0.f;
-        }
+        for (int l : ls) total += weight[size_t(l)];
         double acc = 0.0;
         for (int l : ls) {
-            const float w = luminance(lights[size_t(l)]->power());
-            const double q = total > 0.0 ? (std::isfinite(w) && w > 0.f ? w / total : 0.0)
-                                         : 1.0 / double(ls.size());
-            within_[size_t(l)] = float(q);
+            const double q = total > 0.0 ? weight[size_t(l)] / total : 1.0 / double(ls.size());
+            of_[size_t(l)].within = float(q);
             acc += q;
             members_.push_back(l);
             cdf_.push_back(float(acc));
@@ -223,8 +227,7 @@ std::unique_ptr<LightSampler> createLightSampler(const std::string& strategy,
         std::vector<float> w(lights.size());
         double total = 0;
         for (size_t i = 0; i < lights.size(); ++i) {
-            float p = luminance(lights[i]->power());
-            w[i] = std::isfinite(p) && p > 0.f ? p : 0.f;
+            w[i] = powerWeight(*lights[i]);
             total += w[i];
         }
         if (!(total > 0)) std::fill(w.begin(), w.end(), 1.f);

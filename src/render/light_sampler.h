@@ -49,15 +49,19 @@ public:
     LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
                 const std::vector<int>& emitter);
     int count() const { return first_.empty() ? 0 : int(first_.size()) - 1; }
-    int group(int light) const { return group_[size_t(light)]; }
+    int group(int light) const { return of_[size_t(light)].group; }
     // The probability of `light` among its group's lights.
-    float within(int light) const { return within_[size_t(light)]; }
+    float within(int light) const { return of_[size_t(light)].within; }
     // A light of group g from u in [0,1), with probability within().
     int sample(int g, float u) const;
 
 private:
-    std::vector<int> group_;       // per light
-    std::vector<float> within_;    // per light
+    // Per light, side by side (both are read for every shadow ray's pmf).
+    struct Of {
+        int group;
+        float within;
+    };
+    std::vector<Of> of_;
     std::vector<int> first_;       // per group + 1: its range in members_ / cdf_
     std::vector<int> members_;     // lights by group
     std::vector<float> cdf_;       // per member: the within-group CDF after it
