@@ -30,29 +30,46 @@ void checkPair(const Image& test, const Image& ref, const char* what) {
 
 }  // namespace
 
-double relMseTrimmed(const Image& test, const Image& ref) {
-    checkPair(test, ref, "relMseTrimmed");
-    const size_t n = size_t(test.width) * test.height;
+namespace {
+
+// The trimmed mean of e_p = mean over R,G,B of (x - y)^2 / (r^2 + 0.01), dropping the
+// `renders` x floor(N / 1000) largest values; NaN if any e_p is not finite.
+double trimmedWeightedSquares(const Image& x, const Image& y, const Image& r, size_t renders) {
+    const size_t n = size_t(x.width) * x.height;
     std::vector<double> e(n);
     for (size_t i = 0; i < n; ++i) {
         double sum = 0;
         for (int c = 0; c < 3; ++c) {
-            double x = test.pixels[i * test.channels + c];
-            double r = ref.pixels[i * ref.channels + c];
-            sum += (x - r) * (x - r) / (r * r + 0.01);
+            const double a = x.pixels[i * x.channels + c];
+            const double b = y.pixels[i * y.channels + c];
+            const double w = r.pixels[i * r.channels + c];
+            sum += (a - b) * (a - b) / (w * w + 0.01);
         }
         e[i] = sum / 3;
     }
     // NaNs would break the ordering below; a non-finite input has no meaningful error.
     for (double v : e)
         if (!std::isfinite(v)) return std::numeric_limits<double>::quiet_NaN();
-    const size_t drop = n / 1000;
+    const size_t drop = std::min(n - 1, renders * (n / 1000));
     const size_t keep = n - drop;
     // Move the `keep` smallest values to the front.
     if (drop > 0) std::nth_element(e.begin(), e.begin() + (keep - 1), e.end());
     double sum = 0;
     for (size_t i = 0; i < keep; ++i) sum += e[i];
     return sum / double(keep);
+}
+
+}  // namespace
+
+double relMseTrimmed(const Image& test, const Image& ref) {
+    checkPair(test, ref, "relMseTrimmed");
+    return trimmedWeightedSquares(test, ref, ref, 1);
+}
+
+double pairRelMse(const Image& a, const Image& b, const Image& ref) {
+    checkPair(a, b, "pairRelMse");
+    checkPair(a, ref, "pairRelMse");
+    return 0.5 * trimmedWeightedSquares(a, b, ref, 2);
 }
 
 double blockBias(const Image& test, const Image& ref, int block) {

@@ -16,6 +16,17 @@ namespace rlpbrt {
 // pixel in either image; check with hasNonFinite). Dimensionless.
 double relMseTrimmed(const Image& test, const Image& ref);
 
+// The error of one render without a reference's own noise, from two renders of the same
+// estimator with independent seeds: half the trimmed mean of e_p = mean over R,G,B of
+// (a - b)^2 / (r^2 + 0.01), r from `ref` (only its weights; its noise does not enter),
+// dropping the 2 x floor(N / 1000) largest e_p: the difference carries both renders'
+// outliers, and relMseTrimmed drops one render's 0.1%. For unbiased renders
+// E[(a - b)^2] = Var a + Var b, so this estimates each one's relMseTrimmed against the exact
+// image, and relMseTrimmed(a, ref) minus it the reference's own error (docs/BENCHMARKS.md,
+// "The references' own noise"). Heavy-tailed renders (fireflies that neither render drew)
+// read low. NaN when a value is not finite; throws as relMseTrimmed for mismatched images.
+double pairRelMse(const Image& a, const Image& b, const Image& ref);
+
 // Median block deviation. Both images are split into block x block pixel tiles starting at
 // the top-left corner; partial tiles at the right and bottom edges (when the size is not a
 // multiple of `block`) are ignored. For each tile, mT and mR are the means over its pixels

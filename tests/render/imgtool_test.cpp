@@ -75,5 +75,32 @@ TEST(Imgtool, SideBySideLayoutAndCaptions) {
     for (const std::string& p : {a, b, c}) std::remove(p.c_str());
 }
 
+// pair A B REF: the pair's error (half the weighted squared difference), each render's
+// relmse_trim against REF and their mean less the pair's error (REF's own error).
+TEST(Imgtool, PairSeparatesTheReferencesError) {
+    const std::string a = tempPath("pa.exr"), b = tempPath("pb.exr"), r = tempPath("pr.exr");
+    std::string err;
+    // Against ref 0.1: a = 0.3 and b = 0.1 differ by 0.2: (0.2^2 / 0.02) / 2 = 1 per pixel;
+    // a's relmse_trim is 2, b's 0: reference error (2 + 0) / 2 - 1 = 0.
+    ASSERT_TRUE(writeImage(a, constant(20, 20, 0.3f), {}, &err)) << err;
+    ASSERT_TRUE(writeImage(b, constant(20, 20, 0.1f), {}, &err)) << err;
+    ASSERT_TRUE(writeImage(r, constant(20, 20, 0.1f), {}, &err)) << err;
+    auto run = test::runCommand(std::string(RLPBRT_IMGTOOL) + " pair " + a + " " + b + " " + r);
+    ASSERT_EQ(run.status, 0) << run.output;
+    auto field = [&](const std::string& key) {
+        const size_t at = run.output.find("\"" + key + "\": ");
+        EXPECT_NE(at, std::string::npos) << key << " in " << run.output;
+        return at == std::string::npos ? NAN : std::stod(run.output.substr(at + key.size() + 4));
+    };
+    EXPECT_NEAR(field("pair_relmse"), 1.0, 1e-5);
+    EXPECT_NEAR(field("relmse_a"), 2.0, 1e-5);
+    EXPECT_NEAR(field("relmse_b"), 0.0, 1e-9);
+    EXPECT_NEAR(field("reference_error"), 0.0, 1e-5);
+    // A missing argument: usage, exit 2.
+    run = test::runCommand(std::string(RLPBRT_IMGTOOL) + " pair " + a + " " + b);
+    EXPECT_EQ(run.status, 2);
+    for (const std::string& p : {a, b, r}) std::remove(p.c_str());
+}
+
 }  // namespace
 }  // namespace rlpbrt

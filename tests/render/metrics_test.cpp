@@ -1,5 +1,6 @@
 #include "render/metrics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -8,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -123,6 +125,102 @@ TEST(Metrics, MismatchedImagesThrow) {
     EXPECT_THROW(relMseTrimmed(a, b), std::invalid_argument);
     EXPECT_THROW(blockBias(a, b), std::invalid_argument);
     EXPECT_THROW(relMseTrimmed(a, Image{}), std::invalid_argument);
+}
+
+TEST(PairRelMse, ZeroForIdenticalRenders) {
+    Image ref = constantImage(20, 20, 0.5f, 1.f, 2.f);
+    Image a = constantImage(20, 20, 0.7f, 0.2f, 3.f);
+    EXPECT_EQ(pairRelMse(a, a, ref), 0.0);
+}
+
+TEST(PairRelMse, HalfTheSquaredDifferenceWeightedByTheReference) {
+    // Channel 0: (0.3 - 0.1)^2 / (0.1^2 + 0.01) = 2; channels 1, 2 equal: mean 2/3, half 1/3.
+    // The reference's value enters only the weight (a and b are both away from it).
+    Image ref = constantImage(10, 10, 0.1f, 5.f, 5.f);
+    Image a = constantImage(10, 10, 0.3f, 1.f, 1.f);
+    Image b = constantImage(10, 10, 0.1f, 1.f, 1.f);
+    EXPECT_NEAR(pairRelMse(a, b, ref), 1.0 / 3.0, 1e-6);
+    EXPECT_NEAR(pairRelMse(b, a, ref), 1.0 / 3.0, 1e-6);
+}
+
+TEST(PairRelMse, DropsTwoRendersWorthOfOutliers) {
+    // 1000 pixels: relMseTrimmed drops 1, the pair 2. Two outliers (one per render) and
+    // otherwise equal images: the pair's error is 0, one render's against the other is not.
+    Image ref = constantImage(40, 25, 1.f, 1.f, 1.f);
+    Image a = ref, b = ref;
+    a.at(3, 4, 0) = 50.f;
+    b.at(30, 20, 1) = 50.f;
+    EXPECT_EQ(pairRelMse(a, b, ref), 0.0);
+    EXPECT_GT(relMseTrimmed(a, b), 0.0);
+    b.at(10, 10, 2) = 2.f;  // a third difference stays: (1^2 / 1.01) / 3 / 1000 / 2 per pixel
+    EXPECT_NEAR(pairRelMse(a, b, ref), 1.0 / 1.01 / 3.0 / 998.0 / 2.0, 1e-9);
+}
+
+TEST(PairRelMse, RejectsMismatchedImages) {
+    Image a = constantImage(10, 10, 1.f, 1.f, 1.f);
+    Image small = constantImage(9, 10, 1.f, 1.f, 1.f);
+    EXPECT_THROW(pairRelMse(a, small, a), std::invalid_argument);
+    EXPECT_THROW(pairRelMse(a, a, small), std::invalid_argument);
+}
+
+// Two renders a, b = truth + independent uniform noise, and a reference = truth + its own
+// noise: pairRelMse estimates the renders' error against the truth, and relMseTrimmed(a, ref)
+// minus it the reference's own error, each within 5 standard errors of the per-pixel terms
+// (plus what trimming the largest 0.1% / 0.2% of pixels can remove).
+TEST(PairRelMse, SeparatesTheRendersNoiseFromTheReferences) {
+    const int w = 200, h = 200;
+    const float truth[3] = {1.f, 0.5f, 2.f};
+    const float hr = 0.05f, hx = 0.3f;  // noise half-widths: reference, renders
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    Image t = constantImage(w, h, truth[0], truth[1], truth[2]);
+    Image ref = t, a = t, b = t;
+    for (size_t i = 0; i < ref.pixels.size(); ++i) {
+        ref.pixels[i] += hr * u(rng);
+        a.pixels[i] += hx * u(rng);
+        b.pixels[i] += hx * u(rng);
+    }
+    // Expectations given the reference: E[(a - b)^2] / 2 = hx^2 / 3 per channel, and
+    // E[(a - r)^2] = hx^2 / 3 + (t - r)^2, so their difference is the reference's own error.
+    const size_t n = size_t(w) * h;
+    double expPair = 0, expRef = 0, sdPair = 0, sdA = 0, maxTerm = 0;
+    std::vector<double> pairTerms(n), aTerms(n);
+    for (size_t p = 0; p < n; ++p) {
+        double ep = 0, er = 0, tp = 0, ta = 0;
+        for (int c = 0; c < 3; ++c) {
+            const double r = ref.pixels[p * 3 + c], wgt = 1.0 / (r * r + 0.01);
+            ep += hx * hx / 3.0 * wgt;
+            er += (truth[c] - r) * (truth[c] - r) * wgt;
+            tp += 0.5 * (a.pixels[p * 3 + c] - b.pixels[p * 3 + c]) *
+                  (a.pixels[p * 3 + c] - b.pixels[p * 3 + c]) * wgt;
+            ta += (a.pixels[p * 3 + c] - r) * (a.pixels[p * 3 + c] - r) * wgt;
+        }
+        expPair += ep / 3;
+        expRef += er / 3;
+        pairTerms[p] = tp / 3;
+        aTerms[p] = ta / 3;
+        maxTerm = std::max({maxTerm, pairTerms[p], aTerms[p]});
+    }
+    expPair /= double(n);
+    expRef /= double(n);
+    auto sd = [&](const std::vector<double>& v) {
+        double m = 0, q = 0;
+        for (double x : v) m += x;
+        m /= double(v.size());
+        for (double x : v) q += (x - m) * (x - m);
+        return std::sqrt(q / double(v.size() - 1));
+    };
+    sdPair = sd(pairTerms);
+    sdA = sd(aTerms);
+    const double trim = double(2 * (n / 1000)) / double(n - 2 * (n / 1000)) * maxTerm;
+    const double pair = pairRelMse(a, b, ref);
+    EXPECT_NEAR(pair, expPair, 5 * sdPair / std::sqrt(double(n)) + trim);
+    // The reference's own error is a tenth of the renders': the estimate must find it, not 0
+    // and not the renders' error.
+    ASSERT_LT(expRef, 0.2 * expPair);
+    const double refError = relMseTrimmed(a, ref) - pair;
+    EXPECT_NEAR(refError, expRef, 5 * (sdPair + sdA) / std::sqrt(double(n)) + 2 * trim);
+    EXPECT_GT(refError, 0.5 * expRef);
 }
 
 TEST(BlockBias, HandComputedMedian) {

@@ -1,5 +1,9 @@
 // rlpbrt-imgtool: image utilities for tests, benchmarks and the demo.
 //   rlpbrt-imgtool compare TEST REF   prints relmse_trim, block_bias and nonfinite as JSON
+//   rlpbrt-imgtool pair A B REF       two renders of one estimator (independent seeds): their
+//                                     error without the reference's noise (pairRelMse), each
+//                                     one's relmse_trim against REF, and the difference, an
+//                                     estimate of REF's own error, as JSON
 //   rlpbrt-imgtool convert IN OUT     converts between formats (tone: PNG is sRGB, clamped)
 //   rlpbrt-imgtool side-by-side LEFT RIGHT OUT [CAPTION_LEFT CAPTION_RIGHT]
 //                                     the two images (same size) next to each other, each
@@ -17,7 +21,7 @@ using namespace rlpbrt;
 namespace {
 
 const char* kUsage =
-    "usage: rlpbrt-imgtool compare TEST REF | convert IN OUT |\n"
+    "usage: rlpbrt-imgtool compare TEST REF | pair A B REF | convert IN OUT |\n"
     "       side-by-side LEFT RIGHT OUT [CAPTION_LEFT CAPTION_RIGHT]\n";
 
 bool read(const char* path, Image* img) {
@@ -59,6 +63,18 @@ int compare(const char* testPath, const char* refPath) {
     return 0;
 }
 
+int pair(const char* aPath, const char* bPath, const char* refPath) {
+    Image a, b, ref;
+    if (!read(aPath, &a) || !read(bPath, &b) || !read(refPath, &ref)) return 1;
+    if (!sameSize(a, b) || !sameSize(a, ref)) return 1;
+    const double pairError = pairRelMse(a, b, ref);
+    const double ea = relMseTrimmed(a, ref), eb = relMseTrimmed(b, ref);
+    std::printf("{\"pair_relmse\": %.9g, \"relmse_a\": %.9g, \"relmse_b\": %.9g, "
+                "\"reference_error\": %.9g}\n",
+                pairError, ea, eb, 0.5 * (ea + eb) - pairError);
+    return 0;
+}
+
 // LEFT | gap | RIGHT on a black background, each caption in white on a strip below its
 // image (font scale 2 for images at least 200 pixels wide, else 1).
 int sideBySide(const char* leftPath, const char* rightPath, const char* outPath,
@@ -96,6 +112,7 @@ int sideBySide(const char* leftPath, const char* rightPath, const char* outPath,
 int main(int argc, char** argv) {
     const std::string cmd = argc > 1 ? argv[1] : "";
     if (cmd == "compare" && argc == 4) return compare(argv[2], argv[3]);
+    if (cmd == "pair" && argc == 5) return pair(argv[2], argv[3], argv[4]);
     if (cmd == "convert" && argc == 4) {
         Image a;
         return read(argv[2], &a) && write(argv[3], a) ? 0 : 1;
