@@ -82,13 +82,14 @@ def main():
         for (s, config), seeds in runs.items():
             if s != scene or len(seeds) < 2:
                 continue
-            pairs = [pair(args.tool, seeds[i], seeds[j], refs[scene])
-                     for i, j in itertools.combinations(sorted(seeds), 2)]
-            own = {}
-            for (i, j), p in zip(itertools.combinations(sorted(seeds), 2), pairs):
-                own[i], own[j] = p["relmse_a"], p["relmse_b"]
-            err = sum(p["pair_relmse"] for p in pairs) / len(pairs)
-            stats[config] = (own, err, sum(p["reference_error"] for p in pairs) / len(pairs))
+            own, errs, referrs = {}, [], []  # each seed's relMSE, each pair's figures
+            for i, j in itertools.combinations(sorted(seeds), 2):
+                p = pair(args.tool, seeds[i], seeds[j], refs[scene])
+                own.setdefault(i, p["relmse_a"])
+                own.setdefault(j, p["relmse_b"])
+                errs.append(p["pair_relmse"])
+                referrs.append(p["reference_error"])
+            stats[config] = (own, sum(errs) / len(errs), sum(referrs) / len(referrs))
         base = stats.get(args.base)
         for config in sorted(stats, key=lambda c: (c != args.base, c)):
             own, err, referr = stats[config]

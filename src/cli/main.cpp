@@ -404,11 +404,6 @@ int main(int argc, char** argv) {
             if (passSpp >= cancelAtSpp) gCancel.store(true);
         });
     if (ranks) {
-        if (ranks->size() > 1 && guideSettings.autoSpp > 0) {
-            std::fprintf(stderr, "error: --guide-param auto=N is not supported on several ranks "
-                                 "yet (docs/DISTRIBUTED.md)\n");
-            return fail();
-        }
         if (field && !field->sharesPasses()) {
             std::fprintf(stderr, "error: this guide (%s) cannot be learned by several ranks "
                                  "yet (directions=tree; docs/DISTRIBUTED.md)\n",

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "guiding/field_io.h"
+#include "render/distributed.h"
 
 namespace rlpbrt {
 
@@ -47,6 +48,26 @@ void PassMoments::accumulate(int x, int y, int n, const double sum[3]) {
         m = float((double(m) * before + sum[c]) / total);
     }
     count_[size_t(s)] = total;
+}
+
+void PassMoments::sumAcross(Ranks& ranks) {
+    // Each pixel is set on one rank and zero on the others: the sums are exact.
+    ranks.sumDisjointFloats(mean_.data(), mean_.size(), true);
+    ranks.sumDisjointFloats(var_.data(), var_.size(), true);
+    std::vector<uint32_t> counts(count_.begin(), count_.end());
+    ranks.sumCounts(counts.data(), counts.size());
+    std::copy(counts.begin(), counts.end(), count_.begin());
+}
+
+void PassMoments::clear(const Bounds2i& rect) {
+    for (int y = rect.pMin.y; y < rect.pMax.y; ++y)
+        for (int x = rect.pMin.x; x < rect.pMax.x; ++x) {
+            const long s = slot(x, y);
+            if (s < 0) continue;
+            count_[size_t(s)] = 0;
+            std::fill_n(mean_.begin() + s * 3, 3, 0.f);
+            std::fill_n(var_.begin() + s * 3, 3, 0.f);
+        }
 }
 
 double PassMoments::relativeVariance(const PassMoments& reference) const {

@@ -13,6 +13,8 @@
 
 namespace rlpbrt {
 
+class Ranks;
+
 // Per-pixel sample mean and variance of one pass over a pixel rectangle. At most about
 // maxPixels pixels are tracked (every k-th row beyond that), so memory stays bounded for large
 // films. set() and accumulate() are thread-safe for distinct pixels.
@@ -41,6 +43,12 @@ public:
     // plain rendering better on veach-bidir and breakfast, where guiding wins), and a plain
     // mean is decided by single samples (docs/BENCHMARKS_HISTORY.md, session 5, "A guided-or-plain trial").
     double relativeVariance(const PassMoments& reference) const;
+
+    // Several ranks (render/distributed.h): each sets or accumulates the pixels of its own
+    // tiles; sumAcross() gives every rank all pixels (a collective: every rank calls it), and
+    // clear() forgets the pixels of a rectangle (a resumed rank keeps its own tiles').
+    void sumAcross(Ranks& ranks);
+    void clear(const Bounds2i& rect);
 
     // The tracked pixels' means, variances and counts as bytes (a resumed render's auto
     // trial, render/resume.h), and their restoring into moments over the same rectangle

@@ -62,6 +62,13 @@ FilmTile::FilmTile(const Bounds2i& pixelBounds, Vec2 radius, const FilterTable& 
 
 void FilmTile::clear() { std::fill(pixels_.begin(), pixels_.end(), Pixel()); }
 
+void FilmTile::scale(float w) {
+    for (Pixel& p : pixels_) {
+        p.contrib *= w;
+        p.weightSum *= w;
+    }
+}
+
 void FilmTile::addSample(Vec2 pFilm, Spectrum L, float sampleWeight) {
     // Invalid radiance counts as a black sample (pbrt-v3 zeroes it in the integrator).
     float y = luminance(L);

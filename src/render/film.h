@@ -94,6 +94,9 @@ public:
     float weightSum(int x, int y) const { return pixel(x, y).weightSum; }
     // Resets all sums to zero (to reuse the tile for the next pass).
     void clear();
+    // Multiplies all sums by w >= 0: the tile's samples then weigh w each in the film (the
+    // pixel's value stays their weighted mean).
+    void scale(float w);
     // The sums as a flat array of floats (4 per pixel: RGB and weight), for exchanging tiles
     // between the ranks of a distributed render.
     float* data() { return reinterpret_cast<float*>(pixels_.data()); }

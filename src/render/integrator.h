@@ -98,7 +98,8 @@ struct GuideSettings {
     // render one plain pass as large as the guided pass before it, compare the two passes'
     // costs (relative variance per sample times CPU seconds per sample, render/efficiency.h)
     // and render the rest without guiding (no lookups, no learning) if the guided cost
-    // exceeds 1.15 times the plain one. 0 = always guide (the default): with the path
+    // exceeds the plain one; where guiding stays, the plain pass's samples weigh as a guided
+    // sample's variance against theirs. 0 = always guide (the default): with the path
     // targets the trial misjudges which scenes win (docs/GUIDING.md, `auto`).
     int autoSpp = 0;
     // rr=adjoint: from the second surface vertex on, guided surface vertices play Russian

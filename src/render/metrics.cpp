@@ -28,10 +28,6 @@ void checkPair(const Image& test, const Image& ref, const char* what) {
         throw std::invalid_argument(std::string(what) + ": pixel buffer size mismatch");
 }
 
-}  // namespace
-
-namespace {
-
 // The trimmed mean of e_p = mean over R,G,B of (x - y)^2 / (r^2 + 0.01), dropping the
 // `renders` x floor(N / 1000) largest values; NaN if any e_p is not finite.
 double trimmedWeightedSquares(const Image& x, const Image& y, const Image& r, size_t renders) {

@@ -129,12 +129,16 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // rendered plain if the guided pass cost more than kAutoMargin times the plain one per
     // unit of variance (render/efficiency.h).
     enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
-    constexpr double kAutoMargin = 1.15;
+    // The plain pass is as large as the guided one: a quarter of it (7 spp after 64) reads too
+    // little of plain's variance where rare paths carry it (breakfast's trial then measured
+    // 0.49-1.32 instead of 0.12-0.16; docs/BENCHMARKS_HISTORY.md, session 29).
+    constexpr double kAutoMargin = 1.0;
+
     Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
     // Distributed (docs/DISTRIBUTED.md): this rank renders its tiles of every pass. The auto
-    // trial is not distributed yet (the command line refuses auto=N on several ranks).
+    // trial's moments hold this rank's pixels until it decides (then they are summed over the
+    // ranks: every rank takes the same decision), its CPU seconds are summed over the ranks.
     Ranks* const ranks = options.ranks;
-    if (ranks) trial = Trial::Done;
     // A pass's training records wait in memory until it ends (about 110 bytes per camera
     // path on cornell-box): a pass also takes at most options.maxPassPaths paths per process
     // (4M: about 0.45 GB), so a large image takes fewer samples per pass. Without it a
@@ -216,6 +220,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             if (!guidedMoments->setState(snap->trialGuided))
                 trial = Trial::Done, history.reset(), guidedMoments.reset();
         }
+        // The state holds every rank's pixels: each rank keeps its own until the trial sums them.
+        if (ranks)
+            for (size_t ti = 0; ti < tiles.size(); ++ti)
+                if (!ownsTile(ranks, ti))
+                    for (PassMoments* m : {history.get(), guidedMoments.get()})
+                        if (m) m->clear(tiles[ti]);
         if (field) {
             guided = snap->guided;
             result.autoTrial.ran = snap->autoRan;
@@ -249,14 +259,17 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     for (;;) {
         int count = guided ? std::clamp(result.spp / 2, 1, maxGuidedPass) : 1;
         if (trial == Trial::MeasurePlain) count = guidedCount;
+        double sofar = 0.0;  // seconds so far, with a time budget
+        if (timed) {
+            sofar = now() - start;
+            if (ranks) ranks->broadcast(&sofar, sizeof(sofar));  // rank 0's clock decides
+        }
         if (!timed) {
             count = std::min(count, totalSpp - result.spp);
         } else if (pass > 0) {
             // Only what fits in the budget at the speed so far.
-            double elapsed = now() - start;
-            if (ranks) ranks->broadcast(&elapsed, sizeof(elapsed));  // rank 0's clock decides
-            const double perSpp = elapsed / result.spp;
-            count = std::min(count, int((options.timeBudget - elapsed) / perSpp));
+            const double perSpp = sofar / result.spp;
+            count = std::min(count, int((options.timeBudget - sofar) / perSpp));
         }
         if (count <= 0) break;
         // A learning pass ends where learning does.
@@ -265,7 +278,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         // The trial starts at autoSpp, or a quarter into a time budget if that comes first.
         if (trial == Trial::Pending && count >= 2 &&
             (result.spp + count >= options.guide.autoSpp ||
-             (timed && now() - start >= 0.25 * options.timeBudget))) {
+             (timed && sofar >= 0.25 * options.timeBudget))) {
             trial = Trial::MeasureGuided;
             guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
         } else if (trial == Trial::MeasurePlain) {
@@ -352,14 +365,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 field->endPass();
             result.guideEndPassSeconds += now() - endStart;
         }
-        const double secondsPerSample =
-            (cpuNow() - passStart) / (double(pixelsPerPass) * double(count));
+        double passCpu = cpuNow() - passStart;
+        if (ranks && moments) ranks->sumDoubles(&passCpu, 1);  // (the trial's: all ranks')
+        const double secondsPerSample = passCpu / (double(pixelsPerPass) * double(count));
         if (trial == Trial::MeasureGuided) {
             trial = Trial::MeasurePlain;
             guidedSecondsPerSample = secondsPerSample;
             guidedCount = count;
         } else if (trial == Trial::MeasurePlain) {
             trial = Trial::Done;
+            if (ranks)
+                for (PassMoments* m : {history.get(), guidedMoments.get(), plainMoments.get()})
+                    m->sumAcross(*ranks);
             const double rvGuided = guidedMoments->relativeVariance(*history);
             const double rvPlain = plainMoments->relativeVariance(*history);
             if (rvGuided >= 0.0 && rvPlain >= 0.0) {
@@ -372,6 +389,14 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                     guided = false;
                     result.autoTrial.keptGuiding = false;
                     result.autoTrial.guidedSpp = result.spp;
+                } else if (rvPlain > rvGuided) {
+                    // Where guiding stays, the plain pass's samples weigh as the guided
+                    // pass's per-sample variance against theirs (not yet merged: below). At
+                    // equal weight breakfast's plain samples, with 16 times a guided sample's
+                    // variance, would double the error of a 320-spp render. The weight is a
+                    // statistic of the whole image: its correlation with any one pixel's mean
+                    // is of the order of one over the pixel count.
+                    for (auto& t : tileFilms) t->scale(float(rvGuided / rvPlain));
                 }
             }
             guidedMoments.reset();
@@ -420,6 +445,16 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (decisions[1]) {
             RenderSnapshot snap;
             snap.stats = statsSoFar();  // (all ranks take part)
+            // The trial's moments so far, of all ranks' pixels (a collective with ranks).
+            auto shared = [&](const std::unique_ptr<PassMoments>& m) {
+                if (!m) return std::string();
+                if (!ranks) return m->state();
+                PassMoments all = *m;
+                all.sumAcross(*ranks);
+                return all.state();
+            };
+            const std::string trialHistory = shared(history);
+            const std::string trialGuided = shared(guidedMoments);
             if ((!ranks || ranks->rank() == 0) && options.onSnapshot) {
                 snap.passes = pass;
                 snap.spp = result.spp;
@@ -435,8 +470,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 snap.frozen = frozenIntegrator != nullptr;
                 snap.learningSpp = result.learningSpp;
                 snap.trial = trial == Trial::Pending ? 1 : trial == Trial::MeasurePlain ? 2 : 0;
-                if (history) snap.trialHistory = history->state();
-                if (guidedMoments) snap.trialGuided = guidedMoments->state();
+                snap.trialHistory = trialHistory;
+                snap.trialGuided = trialGuided;
                 snap.trialGuidedSecondsPerSample = guidedSecondsPerSample;
                 snap.trialGuidedCount = guidedCount;
                 snap.film = film.sums();

@@ -4,6 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <deque>
+#include <vector>
+
+#include "render/distributed.h"
+
 namespace rlpbrt {
 namespace {
 
@@ -68,6 +73,97 @@ TEST(PassMoments, LargeFilmsTrackEveryKthRow) {
     EXPECT_FALSE(pass.tracked(996, -4));  // outside
     PassMoments other(kBounds);
     EXPECT_EQ(pass.relativeVariance(other), -1.0);  // different rectangles
+}
+
+// Two ranks played in one process: the first records the buffers its rank puts into the
+// collectives (as a rank whose partner has only zeros), the second adds those to its own, as
+// the element-wise sums of two ranks would.
+class TwoRanksInTurn final : public Ranks {
+public:
+    explicit TwoRanksInTurn(int rank) : rank_(rank) {}
+    int rank() const override { return rank_; }
+    int size() const override { return 2; }
+    void sumDoubles(double*, size_t) override { ADD_FAILURE() << "not used"; }
+    void sumCounts(uint32_t* data, size_t n) override {
+        if (rank_ == 0) {
+            counts_.emplace_back(data, data + n);
+            return;
+        }
+        ASSERT_FALSE(counts_.empty());
+        ASSERT_EQ(counts_.front().size(), n);
+        for (size_t i = 0; i < n; ++i) data[i] += counts_.front()[i];
+        counts_.pop_front();
+    }
+    void sumDisjointFloats(float* data, size_t n, bool everyone) override {
+        EXPECT_TRUE(everyone);  // every rank takes the trial's decision
+        if (rank_ == 0) {
+            floats_.emplace_back(data, data + n);
+            return;
+        }
+        ASSERT_FALSE(floats_.empty());
+        ASSERT_EQ(floats_.front().size(), n);
+        for (size_t i = 0; i < n; ++i) {
+            EXPECT_TRUE(data[i] == 0.f || floats_.front()[i] == 0.f) << "not disjoint at " << i;
+            data[i] += floats_.front()[i];
+        }
+        floats_.pop_front();
+    }
+    void gatherBytes(std::string&) override { ADD_FAILURE() << "not used"; }
+    void broadcast(void*, size_t) override { ADD_FAILURE() << "not used"; }
+    bool allOk(bool ok) override { return ok; }
+    uint64_t bytesExchanged() const override { return 0; }
+    double secondsExchanging() const override { return 0.0; }
+    void pass(const TwoRanksInTurn& first) {
+        floats_ = first.floats_;
+        counts_ = first.counts_;
+    }
+
+private:
+    int rank_;
+    std::deque<std::vector<float>> floats_;
+    std::deque<std::vector<uint32_t>> counts_;
+};
+
+// The auto trial on several ranks (render.cpp): each rank holds the moments of its own
+// pixels; summed over the ranks they are the moments of one process that saw every pixel,
+// and a resumed rank forgets the pixels of the tiles it does not render.
+TEST(PassMoments, SummedAcrossRanksEqualOneProcess) {
+    PassMoments whole(kBounds), wholeRef(kBounds);
+    PassMoments left(kBounds), leftRef(kBounds), right(kBounds), rightRef(kBounds);
+    for (int y = 0; y < 10; ++y)
+        for (int x = 0; x < 30; ++x) {
+            PixelMoments m;
+            m.add(Spectrum(float(x + 1), float(y + 1), 1.f));
+            m.add(Spectrum(float(2 * x), float(y * y), 3.f));
+            const double mean[3] = {double(x % 7), 2.0, double(y)};
+            const bool mine = x < 12;  // the first rank's tile: x in [0, 12)
+            whole.set(x, y, m.n, m.sum, m.sumSq);
+            wholeRef.accumulate(x, y, 2, mean);
+            (mine ? left : right).set(x, y, m.n, m.sum, m.sumSq);
+            (mine ? leftRef : rightRef).accumulate(x, y, 2, mean);
+        }
+    TwoRanksInTurn first(0), second(1);
+    left.sumAcross(first);
+    leftRef.sumAcross(first);
+    second.pass(first);
+    right.sumAcross(second);
+    rightRef.sumAcross(second);
+    EXPECT_EQ(right.state(), whole.state());
+    EXPECT_EQ(rightRef.state(), wholeRef.state());
+    EXPECT_EQ(right.relativeVariance(rightRef), whole.relativeVariance(wholeRef));
+    EXPECT_GT(whole.relativeVariance(wholeRef), 0.0);
+
+    // clear(): the second rank's pixels only, as before the sum.
+    PassMoments mineOnly(kBounds), mineFromWhole = whole;
+    for (int y = 0; y < 10; ++y)
+        for (int x = 12; x < 30; ++x) {
+            PixelMoments m;
+            m.add(Spectrum(float(x + 1), float(y + 1), 1.f));
+            m.add(Spectrum(float(2 * x), float(y * y), 3.f));
+            mineOnly.set(x, y, m.n, m.sum, m.sumSq);
+        }
+    mineFromWhole.clear(Bounds2i(glm::ivec2(0, 0), glm::ivec2(12, 10)));
+    EXPECT_EQ(mineFromWhole.state(), mineOnly.state());
 }
 
 }  // namespace

@@ -290,6 +290,30 @@ TEST(Film, SampleSplatsWithTabulatedFilterWeights) {
     EXPECT_FLOAT_EQ(tile->contribution(10, 10).x, 0.5f * tile->weightSum(10, 10));
 }
 
+// A scaled tile's samples weigh the factor each in the film (the auto trial's plain pass,
+// render.cpp): the pixel is their weighted mean with the other passes' samples.
+TEST(Film, ScaledTileWeighsItsSamples) {
+    Film film(filmParams(8, 8), makeFilter("box"));
+    const Bounds2i all({0, 0}, {8, 8});
+    std::vector<std::unique_ptr<FilmTile>> tiles;
+    tiles.push_back(film.makeTile(all));
+    tiles[0]->addSample(Vec2(3.5f, 3.5f), Spectrum(1.f, 2.f, 4.f));
+    film.mergeTiles(tiles);
+    tiles[0]->clear();
+    tiles[0]->addSample(Vec2(3.5f, 3.5f), Spectrum(5.f, 10.f, 20.f));
+    tiles[0]->addSample(Vec2(3.5f, 3.5f), Spectrum(5.f, 10.f, 20.f), 0.5f);
+    const float w1 = tiles[0]->weightSum(3, 3);
+    tiles[0]->scale(0.25f);
+    EXPECT_FLOAT_EQ(tiles[0]->weightSum(3, 3), 0.25f * w1);
+    film.mergeTiles(tiles);
+    const Image img = film.toImage();
+    // (1 x 1 + 0.25 x (5 + 2.5)) / (1 + 0.25 x 2) for red; the others alike.
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(img.at(3, 3, c), float(1 << c) * (1.f + 0.25f * 7.5f) / 1.5f, 1e-5f) << c;
+    tiles[0]->scale(0.f);  // a tile scaled to nothing adds nothing
+    EXPECT_EQ(tiles[0]->weightSum(3, 3), 0.f);
+}
+
 // Splats L at a jittered 3x3 grid of samples in every pixel of the sample bounds.
 void splatUniform(Film& film, Spectrum L, int tileSize = 16, uint32_t seed = 1) {
     std::vector<std::unique_ptr<FilmTile>> tiles;
