@@ -502,6 +502,7 @@ int main(int argc, char** argv) {
             if (at.ran) {
                 j["guide_auto_guided_cost"] = at.guidedCost;
                 j["guide_auto_plain_cost"] = at.plainCost;
+                j["guide_auto_plain_spp"] = at.plainSpp;
             }
         }
         j["nonfinite_samples"] = s.nonFinite;

@@ -38,6 +38,27 @@ void PassMoments::set(int x, int y, int n, const double sum[3], const double sum
     }
 }
 
+void PassMoments::add(int x, int y, int n, const double sum[3], const double sumSq[3]) {
+    const long s = slot(x, y);
+    if (s < 0 || n <= 0) return;
+    const int before = count_[size_t(s)];
+    if (before == 0) return set(x, y, n, sum, sumSq);
+    // Pooled moments: the sums of squares about each part's mean, plus the spread of the means.
+    const int total = before + n;
+    count_[size_t(s)] = total;
+    for (size_t c = 0; c < 3; ++c) {
+        float& m = mean_[size_t(s) * 3 + c];
+        float& v = var_[size_t(s) * 3 + c];
+        const double m1 = double(m), m2 = sum[c] / n;
+        const double ss1 = double(v) * (before - 1);
+        const double ss2 = std::max(0.0, sumSq[c] - sum[c] * m2);
+        const double d = m2 - m1;
+        const double ss = ss1 + ss2 + d * d * double(before) * double(n) / total;
+        m = float((m1 * before + sum[c]) / total);
+        v = float(ss / (total - 1));
+    }
+}
+
 void PassMoments::accumulate(int x, int y, int n, const double sum[3]) {
     const long s = slot(x, y);
     if (s < 0 || n <= 0) return;

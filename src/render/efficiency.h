@@ -25,6 +25,8 @@ public:
     bool tracked(int x, int y) const { return slot(x, y) >= 0; }
     // The n samples of pixel (x, y) in this pass: their sums and sums of squares per channel.
     void set(int x, int y, int n, const double sum[3], const double sumSq[3]);
+    // The same n samples added to those set before (a pass measured in parts); set() if none.
+    void add(int x, int y, int n, const double sum[3], const double sumSq[3]);
     size_t trackedPixels() const { return mean_.size() / 3; }
 
     // Adds the n samples of pixel (x, y) to its running mean (pixel means over several

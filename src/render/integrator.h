@@ -96,12 +96,12 @@ struct GuideSettings {
     bool independentPasses = false;
     // auto=N (render loop): after about N samples per pixel (or a quarter of a time budget),
     // render one plain pass as large as the guided pass before it, compare the two passes'
-    // costs (relative variance per sample times CPU seconds per sample, render/efficiency.h)
-    // and render the rest without guiding (no lookups, no learning) if the guided cost
+    // costs (relative variance per sample, render/efficiency.h, times CPU seconds per sample
+    // with a time budget: a render of fixed spp stays a function of its seed) and render the rest without guiding (no lookups, no learning) if the guided cost
     // exceeds the plain one; where guiding stays, the plain pass's samples weigh as a guided
-    // sample's variance against theirs. 0 = always guide (the default): with the path
-    // targets the trial misjudges which scenes win (docs/GUIDING.md, `auto`).
-    int autoSpp = 0;
+    // sample's variance against theirs. 0 = always guide. The default, 64: after 64 spp the
+    // trial told apart the scenes that lose at equal time (docs/GUIDING.md, `auto`).
+    int autoSpp = 64;
     // rr=adjoint: from the second surface vertex on, guided surface vertices play Russian
     // roulette on the path's expected remaining contribution, throughput x the learned Q of
     // the sampled direction, against the pixel's estimate from earlier passes (Vorba and

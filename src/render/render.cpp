@@ -125,14 +125,21 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // Halves learned better than doubling pass sizes (docs/BENCHMARKS_HISTORY.md).
     bool guided = field != nullptr;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
-    // that reaches autoSpp (or a quarter of a time budget) is measured, then a plain pass of the same size; the rest is
-    // rendered plain if the guided pass cost more than kAutoMargin times the plain one per
-    // unit of variance (render/efficiency.h).
-    enum class Trial { Pending, MeasureGuided, MeasurePlain, Done };
+    // that reaches autoSpp (or a quarter of a time budget) is measured, then a plain pass of
+    // the same size; the rest is rendered plain if the guided pass cost more than kAutoMargin
+    // times the plain one (render/efficiency.h): per unit of variance with a time budget
+    // (relative variance per sample times CPU seconds per sample), per sample with a sample
+    // count (relative variance alone: the spp are fixed, and the verdict, like the image,
+    // then depends on the seed only).
+    enum class Trial { Pending, MeasureGuided, MeasurePlain, MeasurePlainRest, Done };
     // The plain pass is as large as the guided one: a quarter of it (7 spp after 64) reads too
     // little of plain's variance where rare paths carry it (breakfast's trial then measured
-    // 0.49-1.32 instead of 0.12-0.16; docs/BENCHMARKS_HISTORY.md, session 29).
+    // 0.49-1.32 instead of 0.12-0.16; docs/BENCHMARKS_HISTORY.md, session 29). But it is
+    // measured in two parts, a quarter first: too little variance read makes plain look
+    // better, never worse, so if guiding wins by kAutoEarly already after the quarter, it
+    // stays, and the plain samples that would cost the winners most are never drawn.
     constexpr double kAutoMargin = 1.0;
+    constexpr double kAutoEarly = 0.85;
 
     Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
     // Distributed (docs/DISTRIBUTED.md): this rank renders its tiles of every pass. The auto
@@ -156,6 +163,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         trial == Trial::Pending ? std::make_unique<PassMoments>(film.sampleBounds()) : nullptr;
     double guidedSecondsPerSample = 0.0;
     int guidedCount = 0;
+    double plainSeconds = 0.0;  // CPU seconds of the plain pass's parts so far
+    int plainCount = 0;         // ... and their spp
     // learn=N (GuideSettings::learnSpp): guided passes learn until N samples per pixel, then
     // sample from the guide as it is with an integrator that records nothing.
     const int learnSpp = options.guide.learnSpp;
@@ -209,22 +218,31 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         earlierStats = snap->stats;
         result.guideEndPassSeconds = snap->guideEndPassSeconds;
         // The auto trial where it stood (a state without one, or after it: over).
-        trial = snap->trial == 1 ? Trial::Pending : snap->trial == 2 ? Trial::MeasurePlain
-                                                                      : Trial::Done;
+        trial = snap->trial == 1   ? Trial::Pending
+                : snap->trial == 2 ? Trial::MeasurePlain
+                : snap->trial == 3 ? Trial::MeasurePlainRest
+                                   : Trial::Done;
         if (trial == Trial::Done || !history || !history->setState(snap->trialHistory))
             trial = Trial::Done, history.reset();
-        if (trial == Trial::MeasurePlain) {
+        if (trial == Trial::MeasurePlain || trial == Trial::MeasurePlainRest) {
             guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
             guidedSecondsPerSample = snap->trialGuidedSecondsPerSample;
             guidedCount = snap->trialGuidedCount;
             if (!guidedMoments->setState(snap->trialGuided))
                 trial = Trial::Done, history.reset(), guidedMoments.reset();
         }
+        if (trial == Trial::MeasurePlainRest) {
+            plainMoments = std::make_unique<PassMoments>(film.sampleBounds());
+            plainSeconds = snap->trialPlainSeconds;
+            plainCount = snap->trialPlainCount;
+            if (!plainMoments->setState(snap->trialPlain))
+                trial = Trial::Done, history.reset(), guidedMoments.reset(), plainMoments.reset();
+        }
         // The state holds every rank's pixels: each rank keeps its own until the trial sums them.
         if (ranks)
             for (size_t ti = 0; ti < tiles.size(); ++ti)
                 if (!ownsTile(ranks, ti))
-                    for (PassMoments* m : {history.get(), guidedMoments.get()})
+                    for (PassMoments* m : {history.get(), guidedMoments.get(), plainMoments.get()})
                         if (m) m->clear(tiles[ti]);
         if (field) {
             guided = snap->guided;
@@ -233,6 +251,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             result.autoTrial.guidedSpp = snap->autoGuidedSpp;
             result.autoTrial.guidedCost = snap->autoGuidedCost;
             result.autoTrial.plainCost = snap->autoPlainCost;
+            result.autoTrial.plainSpp = snap->autoPlainSpp;
             if (!guided) plainIntegrator = std::make_unique<PathIntegrator>(scene, GuideSettings());
             if (snap->frozen) {
                 GuideSettings frozen = options.guide;
@@ -256,9 +275,56 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         s.add(earlierStats);
         return s;
     };
+    // The auto trial's verdict after its plain pass, or after the first part of it (partial:
+    // the rest may follow); passSpp of the plain samples are in this pass's tiles, not yet
+    // merged into the film.
+    auto decideTrial = [&](bool partial, int passSpp) {
+        // With ranks, every rank's pixels (in copies: a part to come adds to each rank's own).
+        auto all = [&](const PassMoments& m) {
+            PassMoments sum = m;
+            if (ranks) sum.sumAcross(*ranks);
+            return sum;
+        };
+        const PassMoments past = all(*history);
+        const double rvGuided = all(*guidedMoments).relativeVariance(past);
+        const double rvPlain = all(*plainMoments).relativeVariance(past);
+        const bool valid = rvGuided >= 0.0 && rvPlain >= 0.0;
+        const double guidedCost = rvGuided * (timed ? guidedSecondsPerSample : 1.0);
+        const double plainCost =
+            rvPlain * (timed ? plainSeconds / (double(pixelsPerPass) * plainCount) : 1.0);
+        if (partial && !(valid && guidedCost < kAutoEarly * plainCost)) {
+            trial = Trial::MeasurePlainRest;
+            return;
+        }
+        trial = Trial::Done;
+        if (valid) {
+            result.autoTrial.ran = true;
+            result.autoTrial.guidedCost = guidedCost;
+            result.autoTrial.plainCost = plainCost;
+            result.autoTrial.plainSpp = plainCount;
+            if (guidedCost > kAutoMargin * plainCost) {
+                guided = false;
+                result.autoTrial.keptGuiding = false;
+                result.autoTrial.guidedSpp = result.spp + passSpp - plainCount;
+            } else if (rvPlain > rvGuided) {
+                // Where guiding stays, this pass's plain samples weigh as a guided sample's
+                // variance against theirs (a first part's, merged already, weigh 1: it goes
+                // on only where the two are close). At equal weight breakfast's plain samples,
+                // with 16 times a guided sample's variance, would double the error of a
+                // 320-spp render. The weight is a statistic of the whole image: its
+                // correlation with any one pixel's mean is of the order of one over the pixel
+                // count.
+                for (auto& t : tileFilms) t->scale(float(rvGuided / rvPlain));
+            }
+        }
+        guidedMoments.reset();
+        plainMoments.reset();
+        history.reset();
+    };
     for (;;) {
         int count = guided ? std::clamp(result.spp / 2, 1, maxGuidedPass) : 1;
-        if (trial == Trial::MeasurePlain) count = guidedCount;
+        if (trial == Trial::MeasurePlain) count = guidedCount >= 8 ? guidedCount / 4 : guidedCount;
+        if (trial == Trial::MeasurePlainRest) count = guidedCount - plainCount;
         double sofar = 0.0;  // seconds so far, with a time budget
         if (timed) {
             sofar = now() - start;
@@ -288,11 +354,17 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 history.reset();
             } else {
                 plainMoments = std::make_unique<PassMoments>(film.sampleBounds());
-                if (!plainIntegrator)
-                    plainIntegrator = std::make_unique<PathIntegrator>(scene, GuideSettings());
+                plainSeconds = 0.0;
+                plainCount = 0;
             }
+        } else if (trial == Trial::MeasurePlainRest && count < 2) {
+            decideTrial(false, 0);  // no room for the rest: the verdict of the first part
         }
-        const bool guidedPass = guided && trial != Trial::MeasurePlain;
+        const bool plainTrialPass =
+            trial == Trial::MeasurePlain || trial == Trial::MeasurePlainRest;
+        if (plainTrialPass && !plainIntegrator)
+            plainIntegrator = std::make_unique<PathIntegrator>(scene, GuideSettings());
+        const bool guidedPass = guided && !plainTrialPass;
         const bool learningPass = guidedPass && learning;
         if (guidedPass && !learningPass && !frozenIntegrator) {
             GuideSettings frozen = options.guide;
@@ -305,9 +377,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                                                : guidedPass      ? *frozenIntegrator
                                                : plainIntegrator ? *plainIntegrator
                                                                  : integrator;
-        PassMoments* moments = trial == Trial::MeasureGuided  ? guidedMoments.get()
-                               : trial == Trial::MeasurePlain ? plainMoments.get()
-                                                              : nullptr;
+        PassMoments* moments = trial == Trial::MeasureGuided ? guidedMoments.get()
+                               : plainTrialPass              ? plainMoments.get()
+                                                             : nullptr;
         const double passStart = cpuNow();
         // An independent pass: its own sample set, indices from 0; otherwise the next samples
         // of the one sequence per pixel.
@@ -350,7 +422,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                             if (measured) pixel.add(L * cr.weight);
                         }
                         if (measured && moments)
-                            moments->set(x, y, pixel.n, pixel.sum, pixel.sumSq);
+                            moments->add(x, y, pixel.n, pixel.sum, pixel.sumSq);
                         else if (measured)
                             history->accumulate(x, y, pixel.n, pixel.sum);
                     }
@@ -367,41 +439,14 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         }
         double passCpu = cpuNow() - passStart;
         if (ranks && moments) ranks->sumDoubles(&passCpu, 1);  // (the trial's: all ranks')
-        const double secondsPerSample = passCpu / (double(pixelsPerPass) * double(count));
         if (trial == Trial::MeasureGuided) {
             trial = Trial::MeasurePlain;
-            guidedSecondsPerSample = secondsPerSample;
+            guidedSecondsPerSample = passCpu / (double(pixelsPerPass) * double(count));
             guidedCount = count;
-        } else if (trial == Trial::MeasurePlain) {
-            trial = Trial::Done;
-            if (ranks)
-                for (PassMoments* m : {history.get(), guidedMoments.get(), plainMoments.get()})
-                    m->sumAcross(*ranks);
-            const double rvGuided = guidedMoments->relativeVariance(*history);
-            const double rvPlain = plainMoments->relativeVariance(*history);
-            if (rvGuided >= 0.0 && rvPlain >= 0.0) {
-                result.autoTrial.ran = true;
-                result.autoTrial.guidedCost = rvGuided * guidedSecondsPerSample;
-                result.autoTrial.plainCost = rvPlain * secondsPerSample;
-                // Guiding must be clearly worse to be dropped: the guide is still learning,
-                // and the estimate spreads (docs/BENCHMARKS.md).
-                if (result.autoTrial.guidedCost > kAutoMargin * result.autoTrial.plainCost) {
-                    guided = false;
-                    result.autoTrial.keptGuiding = false;
-                    result.autoTrial.guidedSpp = result.spp;
-                } else if (rvPlain > rvGuided) {
-                    // Where guiding stays, the plain pass's samples weigh as the guided
-                    // pass's per-sample variance against theirs (not yet merged: below). At
-                    // equal weight breakfast's plain samples, with 16 times a guided sample's
-                    // variance, would double the error of a 320-spp render. The weight is a
-                    // statistic of the whole image: its correlation with any one pixel's mean
-                    // is of the order of one over the pixel count.
-                    for (auto& t : tileFilms) t->scale(float(rvGuided / rvPlain));
-                }
-            }
-            guidedMoments.reset();
-            plainMoments.reset();
-            history.reset();
+        } else if (plainTrialPass) {
+            plainSeconds += passCpu;
+            plainCount += count;
+            decideTrial(plainCount < guidedCount, count);
         }
         if (ranks) {
             // Each tile was rendered by one rank: the sums are exact, and the film is then
@@ -455,6 +500,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             };
             const std::string trialHistory = shared(history);
             const std::string trialGuided = shared(guidedMoments);
+            const std::string trialPlain =
+                trial == Trial::MeasurePlainRest ? shared(plainMoments) : std::string();
             if ((!ranks || ranks->rank() == 0) && options.onSnapshot) {
                 snap.passes = pass;
                 snap.spp = result.spp;
@@ -467,13 +514,20 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 snap.autoGuidedSpp = result.autoTrial.guidedSpp;
                 snap.autoGuidedCost = result.autoTrial.guidedCost;
                 snap.autoPlainCost = result.autoTrial.plainCost;
+                snap.autoPlainSpp = result.autoTrial.plainSpp;
                 snap.frozen = frozenIntegrator != nullptr;
                 snap.learningSpp = result.learningSpp;
-                snap.trial = trial == Trial::Pending ? 1 : trial == Trial::MeasurePlain ? 2 : 0;
+                snap.trial = trial == Trial::Pending            ? 1
+                             : trial == Trial::MeasurePlain     ? 2
+                             : trial == Trial::MeasurePlainRest ? 3
+                                                                : 0;
                 snap.trialHistory = trialHistory;
                 snap.trialGuided = trialGuided;
                 snap.trialGuidedSecondsPerSample = guidedSecondsPerSample;
                 snap.trialGuidedCount = guidedCount;
+                snap.trialPlain = trialPlain;
+                snap.trialPlainSeconds = plainSeconds;
+                snap.trialPlainCount = plainCount;
                 snap.film = film.sums();
                 snap.estimates = estimates.values();
                 std::string err;

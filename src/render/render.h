@@ -61,12 +61,13 @@ struct RenderResult {
     double guideEndPassSeconds = 0.0;
     // The auto trial of a guided render (GuideSettings::autoSpp): whether it ran, its verdict,
     // the spp at which guiding stopped (= spp if it never did), and the two passes' costs
-    // (relative variance per sample x CPU seconds per sample).
+    // (relative variance per sample, times CPU seconds per sample with a time budget).
     struct AutoTrial {
         bool ran = false;
         bool keptGuiding = true;
         int guidedSpp = 0;
         double guidedCost = 0.0, plainCost = 0.0;
+        int plainSpp = 0;  // the plain pass's spp (its first part's, if guiding won after it)
     } autoTrial;
     int threads = 1;              // threads per process (RenderOptions::nThreads resolved)
     int ranks = 1;                // processes that rendered (RenderOptions::ranks)

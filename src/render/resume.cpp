@@ -10,7 +10,8 @@ namespace rlpbrt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'L', 'P', 'B', 'R', 'S', 'U', 'M'};
-constexpr uint32_t kVersion = 1;
+// 2: the auto trial's plain pass in two parts (session 29).
+constexpr uint32_t kVersion = 2;
 // Bounds on what a reader accepts (a corrupt count must not allocate without limit).
 constexpr uint64_t kMaxEntries = 4096;
 constexpr uint64_t kMaxFilmDoubles = uint64_t(1) << 30;
@@ -90,6 +91,10 @@ bool writeResumeFile(const std::string& path, const ResumeFingerprint& fingerpri
     w.blob(s.trialGuided);
     w.f64(s.trialGuidedSecondsPerSample);
     w.u32(uint32_t(s.trialGuidedCount));
+    w.blob(s.trialPlain);
+    w.f64(s.trialPlainSeconds);
+    w.u32(uint32_t(s.trialPlainCount));
+    w.u32(uint32_t(s.autoPlainSpp));
     writeArray(w, s.film);
     writeArray(w, s.estimates);
     w.blob(s.guide);
@@ -150,7 +155,12 @@ bool readResumeFile(const std::string& path, ResumeFingerprint* fingerprint,
     s.trialGuided = r.blob();
     s.trialGuidedSecondsPerSample = r.f64();
     s.trialGuidedCount = int(r.u32());
-    if (!r.ok() || s.trial < 0 || s.trial > 2) return fail("corrupt resume file (auto trial)");
+    s.trialPlain = r.blob();
+    s.trialPlainSeconds = r.f64();
+    s.trialPlainCount = int(r.u32());
+    s.autoPlainSpp = int(r.u32());
+    if (!r.ok() || s.trial < 0 || s.trial > 3)
+        return fail("corrupt resume file (auto trial)");
     if (!readArray(r, data, &s.film, kMaxFilmDoubles) || s.film.size() % 4 != 0)
         return fail("corrupt resume file (film)");
     if (!readArray(r, data, &s.estimates, kMaxFilmDoubles / 4))

@@ -29,15 +29,20 @@ struct RenderSnapshot {
     bool autoRan = false, autoKept = true;
     int autoGuidedSpp = 0;
     double autoGuidedCost = 0.0, autoPlainCost = 0.0;
+    int autoPlainSpp = 0;
     bool frozen = false;
     int learningSpp = 0;
     // The auto trial under way (0: none or over; 1: waiting for its guided pass; 2: its guided
-    // pass measured, the plain one next): PassMoments::state of the pixel means so far and of
-    // the guided pass, and the guided pass's CPU seconds per sample and spp.
+    // pass measured, the plain one next; 3: the plain pass's first part measured, its rest
+    // next): PassMoments::state of the pixel means so far, of the guided pass and of the plain
+    // part, the guided pass's CPU seconds per sample and spp, the plain part's CPU seconds and
+    // spp.
     int trial = 0;
-    std::string trialHistory, trialGuided;
+    std::string trialHistory, trialGuided, trialPlain;
     double trialGuidedSecondsPerSample = 0.0;
     int trialGuidedCount = 0;
+    double trialPlainSeconds = 0.0;
+    int trialPlainCount = 0;
     std::vector<double> film;       // Film::sums()
     std::vector<float> estimates;   // the adjoint roulette's pixel estimates (empty: none yet)
     std::string guide;              // GuidingField::saveState (empty without a guide)

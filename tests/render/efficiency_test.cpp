@@ -75,6 +75,28 @@ TEST(PassMoments, LargeFilmsTrackEveryKthRow) {
     EXPECT_EQ(pass.relativeVariance(other), -1.0);  // different rectangles
 }
 
+// A pass measured in two parts: the pooled moments of all its samples.
+TEST(PassMoments, PartsAddUpToTheWholePass) {
+    PassMoments whole(kBounds), parts(kBounds), reference(kBounds);
+    for (int y = 0; y < 10; ++y)
+        for (int x = 0; x < 30; ++x) {
+            PixelMoments all, a, b;
+            for (int i = 0; i < 9; ++i) {
+                const Spectrum L(float((x * 7 + i * i) % 5), float(y + i), float(i == 4) * 9.f);
+                all.add(L);
+                (i < 2 ? a : b).add(L);
+            }
+            whole.set(x, y, all.n, all.sum, all.sumSq);
+            parts.add(x, y, a.n, a.sum, a.sumSq);  // the first part: as set()
+            parts.add(x, y, b.n, b.sum, b.sumSq);
+            const double one[3] = {1.0, 1.0, 1.0};
+            reference.accumulate(x, y, 1, one);
+        }
+    EXPECT_NEAR(parts.relativeVariance(reference), whole.relativeVariance(reference),
+                1e-5 * whole.relativeVariance(reference));
+    EXPECT_GT(whole.relativeVariance(reference), 0.0);
+}
+
 // Two ranks played in one process: the first records the buffers its rank puts into the
 // collectives (as a rank whose partner has only zeros), the second adds those to its own, as
 // the element-wise sums of two ranks would.
