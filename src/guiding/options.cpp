@@ -38,7 +38,7 @@ const std::vector<GuideOption>& guideOptions() {
         {"learn", O::kBoth, kIntegrator, "all", "\"all\" or a sample count in [0, 16777216]",
          "learn in every pass, or in the first N spp only (0 with --guide-load: a trained "
          "guide)"},
-        {"auto", O::kBoth, kIntegrator, "64",
+        {"auto", O::kBoth, kIntegrator, "0",
          "a sample count in [0, 16777216] (0 = always guide)",
          "after N spp compare a guided and a plain pass and render the rest plain if guiding "
          "does not pay"},

@@ -99,9 +99,10 @@ struct GuideSettings {
     // costs (relative variance per sample, render/efficiency.h, times CPU seconds per sample
     // with a time budget: a render of fixed spp stays a function of its seed) and render the rest without guiding (no lookups, no learning) if the guided cost
     // exceeds the plain one; where guiding stays, the plain pass's samples weigh as a guided
-    // sample's variance against theirs. 0 = always guide. The default, 64: after 64 spp the
-    // trial told apart the scenes that lose at equal time (docs/GUIDING.md, `auto`).
-    int autoSpp = 64;
+    // sample's variance against theirs. 0 = always guide, the default: with auto=64 two 30-s
+    // studies gained on metal-spheres and buddha-fractal and lost 3-15% on most other scenes
+    // (docs/GUIDING.md, `auto`).
+    int autoSpp = 0;
     // rr=adjoint: from the second surface vertex on, guided surface vertices play Russian
     // roulette on the path's expected remaining contribution, throughput x the learned Q of
     // the sampled direction, against the pixel's estimate from earlier passes (Vorba and

@@ -275,16 +275,17 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         s.add(earlierStats);
         return s;
     };
+    // The auto trial's moments of every rank's pixels (a collective with ranks), in a copy: a
+    // part to come adds to each rank's own.
+    auto all = [&](const PassMoments& m) {
+        PassMoments sum = m;
+        if (ranks) sum.sumAcross(*ranks);
+        return sum;
+    };
     // The auto trial's verdict after its plain pass, or after the first part of it (partial:
     // the rest may follow); passSpp of the plain samples are in this pass's tiles, not yet
     // merged into the film.
     auto decideTrial = [&](bool partial, int passSpp) {
-        // With ranks, every rank's pixels (in copies: a part to come adds to each rank's own).
-        auto all = [&](const PassMoments& m) {
-            PassMoments sum = m;
-            if (ranks) sum.sumAcross(*ranks);
-            return sum;
-        };
         const PassMoments past = all(*history);
         const double rvGuided = all(*guidedMoments).relativeVariance(past);
         const double rvPlain = all(*plainMoments).relativeVariance(past);
@@ -490,13 +491,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         if (decisions[1]) {
             RenderSnapshot snap;
             snap.stats = statsSoFar();  // (all ranks take part)
-            // The trial's moments so far, of all ranks' pixels (a collective with ranks).
+            // The trial's moments so far, of all ranks' pixels.
             auto shared = [&](const std::unique_ptr<PassMoments>& m) {
-                if (!m) return std::string();
-                if (!ranks) return m->state();
-                PassMoments all = *m;
-                all.sumAcross(*ranks);
-                return all.state();
+                return m ? all(*m).state() : std::string();
             };
             const std::string trialHistory = shared(history);
             const std::string trialGuided = shared(guidedMoments);

@@ -128,7 +128,7 @@ TEST(GuideCrossValidation, IntegratorParametersAreValidated) {
     EXPECT_FALSE(gs.learnMix);
     EXPECT_FALSE(gs.independentPasses);
     EXPECT_FLOAT_EQ(gs.mix, 0.25f);
-    EXPECT_EQ(gs.autoSpp, 64);  // the trial after 64 spp unless told otherwise
+    EXPECT_EQ(gs.autoSpp, 0);  // always guide unless asked
     ASSERT_TRUE(setup({{"auto", "16"}}, &gs, &err)) << err;
     EXPECT_EQ(gs.autoSpp, 16);
     EXPECT_TRUE(gs.adjointRoulette);  // the default
