@@ -26,15 +26,23 @@ long PassMoments::slot(int x, int y) const {
     return row % rowStride_ == 0 ? (row / rowStride_) * width_ + long(x - bounds_.pMin.x) : -1;
 }
 
+namespace {
+// One part's mean and sum of squared deviations from it, from its n samples' sums.
+void partMoments(int n, double sum, double sumSq, double* mean, double* ss) {
+    *mean = sum / n;
+    *ss = std::max(0.0, sumSq - sum * *mean);
+}
+}  // namespace
+
 void PassMoments::set(int x, int y, int n, const double sum[3], const double sumSq[3]) {
     const long s = slot(x, y);
     if (s < 0 || n <= 0) return;
     count_[size_t(s)] = n;
-    for (int c = 0; c < 3; ++c) {
-        const double m = sum[c] / n;
-        const double v = n > 1 ? std::max(0.0, (sumSq[c] - sum[c] * m) / (n - 1)) : 0.0;
-        mean_[size_t(s) * 3 + size_t(c)] = float(m);
-        var_[size_t(s) * 3 + size_t(c)] = float(v);
+    for (size_t c = 0; c < 3; ++c) {
+        double m, ss;
+        partMoments(n, sum[c], sumSq[c], &m, &ss);
+        mean_[size_t(s) * 3 + c] = float(m);
+        var_[size_t(s) * 3 + c] = n > 1 ? float(ss / (n - 1)) : 0.f;
     }
 }
 
@@ -49,9 +57,9 @@ void PassMoments::add(int x, int y, int n, const double sum[3], const double sum
     for (size_t c = 0; c < 3; ++c) {
         float& m = mean_[size_t(s) * 3 + c];
         float& v = var_[size_t(s) * 3 + c];
-        const double m1 = double(m), m2 = sum[c] / n;
-        const double ss1 = double(v) * (before - 1);
-        const double ss2 = std::max(0.0, sumSq[c] - sum[c] * m2);
+        double m2, ss2;
+        partMoments(n, sum[c], sumSq[c], &m2, &ss2);
+        const double m1 = double(m), ss1 = double(v) * (before - 1);
         const double d = m2 - m1;
         const double ss = ss1 + ss2 + d * d * double(before) * double(n) / total;
         m = float((m1 * before + sum[c]) / total);

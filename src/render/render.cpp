@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <unistd.h>
 
@@ -140,6 +141,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // stays, and the plain samples that would cost the winners most are never drawn.
     constexpr double kAutoMargin = 1.0;
     constexpr double kAutoEarly = 0.85;
+    // The first part: a guided pass of kAutoPartsFrom spp or more is followed by a plain one
+    // of 1/kAutoFirstPart its size (a smaller one by a plain pass of its whole size).
+    constexpr int kAutoPartsFrom = 8;
+    constexpr int kAutoFirstPart = 4;
 
     Trial trial = guided && options.guide.autoSpp > 0 ? Trial::Pending : Trial::Done;
     // Distributed (docs/DISTRIBUTED.md): this rank renders its tiles of every pass. The auto
@@ -275,20 +280,29 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         s.add(earlierStats);
         return s;
     };
-    // The auto trial's moments of every rank's pixels (a collective with ranks), in a copy: a
-    // part to come adds to each rank's own.
-    auto all = [&](const PassMoments& m) {
-        PassMoments sum = m;
-        if (ranks) sum.sumAcross(*ranks);
-        return sum;
+    // The auto trial's moments of every rank's pixels (a collective with ranks): m itself on
+    // one process, else a copy summed over the ranks in `sum` (a part to come adds to each
+    // rank's own).
+    auto all = [&](const PassMoments& m, std::optional<PassMoments>& sum) -> const PassMoments& {
+        if (!ranks) return m;
+        sum.emplace(m);
+        sum->sumAcross(*ranks);
+        return *sum;
+    };
+    auto endTrial = [&] {
+        trial = Trial::Done;
+        guidedMoments.reset();
+        plainMoments.reset();
+        history.reset();
     };
     // The auto trial's verdict after its plain pass, or after the first part of it (partial:
     // the rest may follow); passSpp of the plain samples are in this pass's tiles, not yet
     // merged into the film.
     auto decideTrial = [&](bool partial, int passSpp) {
-        const PassMoments past = all(*history);
-        const double rvGuided = all(*guidedMoments).relativeVariance(past);
-        const double rvPlain = all(*plainMoments).relativeVariance(past);
+        std::optional<PassMoments> pastSum, guidedSum, plainSum;
+        const PassMoments& past = all(*history, pastSum);
+        const double rvGuided = all(*guidedMoments, guidedSum).relativeVariance(past);
+        const double rvPlain = all(*plainMoments, plainSum).relativeVariance(past);
         const bool valid = rvGuided >= 0.0 && rvPlain >= 0.0;
         const double guidedCost = rvGuided * (timed ? guidedSecondsPerSample : 1.0);
         const double plainCost =
@@ -297,7 +311,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             trial = Trial::MeasurePlainRest;
             return;
         }
-        trial = Trial::Done;
         if (valid) {
             result.autoTrial.ran = true;
             result.autoTrial.guidedCost = guidedCost;
@@ -318,13 +331,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 for (auto& t : tileFilms) t->scale(float(rvGuided / rvPlain));
             }
         }
-        guidedMoments.reset();
-        plainMoments.reset();
-        history.reset();
+        endTrial();
     };
     for (;;) {
         int count = guided ? std::clamp(result.spp / 2, 1, maxGuidedPass) : 1;
-        if (trial == Trial::MeasurePlain) count = guidedCount >= 8 ? guidedCount / 4 : guidedCount;
+        if (trial == Trial::MeasurePlain)
+            count = guidedCount >= kAutoPartsFrom ? guidedCount / kAutoFirstPart : guidedCount;
         if (trial == Trial::MeasurePlainRest) count = guidedCount - plainCount;
         double sofar = 0.0;  // seconds so far, with a time budget
         if (timed) {
@@ -350,9 +362,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
         } else if (trial == Trial::MeasurePlain) {
             if (count < 2) {
-                trial = Trial::Done;  // no room left for a plain pass to compare with
-                guidedMoments.reset();
-                history.reset();
+                endTrial();  // no room left for a plain pass to compare with
             } else {
                 plainMoments = std::make_unique<PassMoments>(film.sampleBounds());
                 plainSeconds = 0.0;
@@ -493,7 +503,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             snap.stats = statsSoFar();  // (all ranks take part)
             // The trial's moments so far, of all ranks' pixels.
             auto shared = [&](const std::unique_ptr<PassMoments>& m) {
-                return m ? all(*m).state() : std::string();
+                std::optional<PassMoments> sum;
+                return m ? all(*m, sum).state() : std::string();
             };
             const std::string trialHistory = shared(history);
             const std::string trialGuided = shared(guidedMoments);
