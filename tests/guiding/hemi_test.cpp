@@ -23,6 +23,7 @@ namespace {
 using test::cornerScene;
 using test::gaussianDirection;
 using test::planeScene;
+using test::sphereTest;
 using test::trainBright;
 
 std::unique_ptr<HemiField> makeHemi(const SceneInfo& scene,
@@ -42,25 +43,6 @@ double strataIntegral(const HemiField& f, int region) {
     for (int j = 0; j < f.layout().count(); ++j)
         sum += double(f.pdf(region, strataCentre(f, region, j))) * f.layout().stratumSolidAngle();
     return sum;
-}
-
-// World-grid chi-square of sample() against the quadrature of pdf() (chi2.h). Its adaptive
-// quadrature loses ~1e-5 of the mass of sharply peaked pdfs at discontinuities, so peaked
-// fields use 1e5 samples (bias ~1 count, below the ~sqrt(count) noise).
-chi2::SphereResult sphereTest(const GuidingField& f, int region, uint64_t seed,
-                              long long samples = 400000) {
-    chi2::SphereOptions opt;
-    opt.sampleCount = samples;
-    opt.thetaRes = 12;
-    opt.phiRes = 24;
-    opt.seed = seed;
-    return chi2::testSphere(
-        [&](const glm::vec3& u) {
-            chi2::SphereSample s;
-            s.dir = f.sample(region, glm::vec2(u.x, u.y), u.z, &s.pdf);
-            return s;
-        },
-        [&](const glm::vec3& w) { return f.pdf(region, w); }, opt);
 }
 
 // Exact chi-square in the region's strata: each stratum split into 2x2 equal-area sub-cells

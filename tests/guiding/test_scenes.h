@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "guiding/guiding.h"
+#include "render/chi2.h"
 
 namespace rlpbrt::guiding::test {
 
@@ -119,6 +120,27 @@ void expectSameTables(const Field& a, const Field& b) {
     ASSERT_EQ(a.cdfTable().size(), b.cdfTable().size());
     EXPECT_EQ(0, std::memcmp(a.cdfTable().data(), b.cdfTable().data(),
                              a.cdfTable().size() * sizeof(float)));
+}
+
+// World-grid chi-square of a region's sample() against the quadrature of its pdf()
+// (render/chi2.h), 12 x 24 cells; numTests: the tests the 1% family-wise level is shared by.
+// The adaptive quadrature loses ~1e-5 of the mass of sharply peaked pdfs at discontinuities,
+// so peaked fields use 1e5 samples (bias ~1 count, below the ~sqrt(count) noise).
+inline chi2::SphereResult sphereTest(const GuidingField& f, int region, uint64_t seed,
+                                     long long samples = 400000, int numTests = 1) {
+    chi2::SphereOptions opt;
+    opt.sampleCount = samples;
+    opt.thetaRes = 12;
+    opt.phiRes = 24;
+    opt.seed = seed;
+    opt.numTests = numTests;
+    return chi2::testSphere(
+        [&](const glm::vec3& u) {
+            chi2::SphereSample s;
+            s.dir = f.sample(region, glm::vec2(u.x, u.y), u.z, &s.pdf);
+            return s;
+        },
+        [&](const glm::vec3& w) { return f.pdf(region, w); }, opt);
 }
 
 }  // namespace rlpbrt::guiding::test

@@ -29,6 +29,7 @@ namespace {
 using test::cornerScene;
 using test::gaussianDirection;
 using test::planeScene;
+using test::sphereTest;
 using test::trainBright;
 
 std::unique_ptr<VdbField> makeVdb(const SceneInfo& scene,
@@ -47,23 +48,6 @@ double strataIntegral(const VdbField& f, int region) {
 // Each test case below runs up to 8 chi-square tests of each kind (regions x table layouts):
 // a family-wise 1% level over them (Sidak).
 constexpr int kTestsPerCase = 8;
-
-chi2::SphereResult sphereTest(const GuidingField& f, int region, uint64_t seed,
-                              long long samples = 400000) {
-    chi2::SphereOptions opt;
-    opt.sampleCount = samples;
-    opt.thetaRes = 12;
-    opt.phiRes = 24;
-    opt.seed = seed;
-    opt.numTests = kTestsPerCase;
-    return chi2::testSphere(
-        [&](const glm::vec3& u) {
-            chi2::SphereSample s;
-            s.dir = f.sample(region, glm::vec2(u.x, u.y), u.z, &s.pdf);
-            return s;
-        },
-        [&](const glm::vec3& w) { return f.pdf(region, w); }, opt);
-}
 
 // Exact chi-square in the region's own strata: expected count N * P_j per stratum.
 chi2::Result strataTest(const VdbField& f, int region, uint64_t seed, int samples) {
@@ -303,7 +287,7 @@ TEST(VdbField, UntrainedSamplingMatchesPdf) {
         auto f = makeVdb(cornerScene(), {{"voxel", "8"}, {"dirs", dirs}});
         ASSERT_TRUE(f);
         for (int region : {0, 1, f->numRegions() / 2, f->numRegions() - 1}) {
-            chi2::SphereResult r = sphereTest(*f, region, 100 + uint64_t(region));
+            chi2::SphereResult r = sphereTest(*f, region, 100 + uint64_t(region), 400000, kTestsPerCase);
             EXPECT_TRUE(r.passed) << dirs << " region " << region << ": " << r.message;
             EXPECT_NEAR(strataIntegral(*f, region), 1.0, 1e-5) << dirs;
             EXPECT_NEAR(r.pdfIntegral, 1.0, 2e-3) << dirs;
@@ -324,7 +308,7 @@ TEST(VdbField, TrainedSamplingMatchesPdfAndFollowsLight) {
         EXPECT_GT(f->pdf(2, bright), 4.f / (2.f * 3.14159265f)) << dirs;
         EXPECT_GT(f->pdf(3, below), 2.f / (2.f * 3.14159265f)) << dirs;
         for (int region : {2, 3}) {
-            chi2::SphereResult r = sphereTest(*f, region, 200 + uint64_t(region), 100000);
+            chi2::SphereResult r = sphereTest(*f, region, 200 + uint64_t(region), 100000, kTestsPerCase);
             EXPECT_TRUE(r.passed) << dirs << " region " << region << ": " << r.message;
             chi2::Result exact = strataTest(*f, region, 300 + uint64_t(region), 1000000);
             EXPECT_TRUE(exact.passed) << dirs << " region " << region << ": " << exact.message;

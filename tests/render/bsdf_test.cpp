@@ -17,6 +17,31 @@ namespace {
 constexpr int kChi2Family = 180;
 constexpr long long kChi2Samples = 200000;
 
+// One of this file's chi-square tests: sample against the quadrature of pdf, seeded by the
+// case's name.
+template <class Sample, class Pdf>
+chi2::SphereResult fileChi2(const std::string& name, Sample&& sample, Pdf&& pdf) {
+    chi2::SphereOptions opt;
+    opt.sampleCount = kChi2Samples;
+    opt.numTests = kChi2Family;
+    opt.seed = std::hash<std::string>()(name);
+    return chi2::testSphere(sample, pdf, opt);
+}
+
+// The same for a BxDF's or BSDF's sampleF and pdf from wo. Specular samples are delta
+// distributions: they count as "no sample" for the density.
+template <class Scattering>
+chi2::SphereResult scatteringChi2(const std::string& name, const Scattering& x, const Vec3& wo) {
+    return fileChi2(
+        name,
+        [&](const Vec3& u) {
+            const auto s = x.sampleF(wo, u.x, Vec2(u.y, u.z));
+            if (!s.valid() || s.isSpecular()) return chi2::SphereSample();
+            return chi2::SphereSample{s.wi, s.pdf};
+        },
+        [&](const Vec3& wi) { return x.pdf(wo, wi); });
+}
+
 Vec3 dirFromCos(float cosTheta, float phi) {
     float s = safeSqrt(1.f - cosTheta * cosTheta);
     return Vec3(s * std::cos(phi), s * std::sin(phi), cosTheta);
@@ -111,17 +136,7 @@ class BxDFChi2 : public ::testing::TestWithParam<BxDFChi2Case> {};
 
 TEST_P(BxDFChi2, SampleMatchesPdf) {
     const BxDFChi2Case& c = GetParam();
-    auto sample = [&](const Vec3& u) {
-        BxDFSample s = c.bxdf.sampleF(c.wo, u.x, Vec2(u.y, u.z));
-        if (!s.valid() || s.isSpecular()) return chi2::SphereSample();
-        return chi2::SphereSample{s.wi, s.pdf};
-    };
-    auto pdf = [&](const Vec3& wi) { return c.bxdf.pdf(c.wo, wi); };
-    chi2::SphereOptions opt;
-    opt.sampleCount = kChi2Samples;
-    opt.numTests = kChi2Family;
-    opt.seed = std::hash<std::string>()(c.name);
-    chi2::SphereResult r = chi2::testSphere(sample, pdf, opt);
+    chi2::SphereResult r = scatteringChi2(c.name, c.bxdf, c.wo);
     EXPECT_TRUE(r.passed) << r.message;
 }
 
@@ -160,11 +175,7 @@ TEST_P(VisibleNormalChi2, SampleWhMatchesPdf) {
         if (glm::dot(c.wo, wh) <= 0.f || wh.z * c.wo.z <= 0.f) return 0.f;
         return c.dist.pdf(c.wo, wh);
     };
-    chi2::SphereOptions opt;
-    opt.sampleCount = kChi2Samples;
-    opt.numTests = kChi2Family;
-    opt.seed = std::hash<std::string>()(c.name);
-    chi2::SphereResult r = chi2::testSphere(sample, pdf, opt);
+    chi2::SphereResult r = fileChi2(c.name, sample, pdf);
     EXPECT_TRUE(r.passed) << r.message;
     EXPECT_NEAR(r.pdfIntegral, 1.0, 2e-3);
 }
@@ -289,19 +300,7 @@ TEST_P(MaterialChi2, SampleMatchesPdf) {
     BSDF bsdf = makeFramedBSDF();
     c.build(bsdf);
     ASSERT_GT(bsdf.numComponents(), 0);
-    Vec3 wo = bsdf.localToWorld(c.woLocal);
-    // Specular samples are delta distributions: they count as "no sample" for the density.
-    auto sample = [&](const Vec3& u) {
-        BSDFSample s = bsdf.sampleF(wo, u.x, Vec2(u.y, u.z));
-        if (!s.valid() || s.isSpecular()) return chi2::SphereSample();
-        return chi2::SphereSample{s.wi, s.pdf};
-    };
-    auto pdf = [&](const Vec3& wi) { return bsdf.pdf(wo, wi); };
-    chi2::SphereOptions opt;
-    opt.sampleCount = kChi2Samples;
-    opt.numTests = kChi2Family;
-    opt.seed = std::hash<std::string>()(c.name);
-    chi2::SphereResult r = chi2::testSphere(sample, pdf, opt);
+    chi2::SphereResult r = scatteringChi2(c.name, bsdf, bsdf.localToWorld(c.woLocal));
     EXPECT_TRUE(r.passed) << r.message;
 }
 

@@ -14,6 +14,7 @@
 #include "render/bxdfs.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -234,14 +235,10 @@ struct MaterialHit {
 MaterialHit materialHit(const std::string& material) {
     MaterialHit out;
     Diagnostics diag;
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
-    std::string text = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n"
-                       "LightSource \"infinite\"\n" +
-                       material + "\nShape \"sphere\" \"float radius\" 1\nWorldEnd\n";
-    if (!parseString(text, "sss.pbrt", builder, diag)) return out;
-    SceneDesc desc = builder.takeDesc();
-    out.scene = buildScene(desc, BuildOptions(), diag);
+    out.scene = test::sceneFromText("LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                                    "LightSource \"infinite\"\n" +
+                                        material + "\nShape \"sphere\" \"float radius\" 1\nWorldEnd\n",
+                                    "sss.pbrt", diag);
     if (!out.scene) return out;
     SurfaceInteraction si;
     if (!out.scene->intersect(Ray(Vec3(0.1f, 0.2f, 5.f), Vec3(0, 0, -1)), &si)) return out;

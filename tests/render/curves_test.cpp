@@ -12,6 +12,7 @@
 #include "render/curves.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -179,13 +180,9 @@ TEST(Curves, RaysLeavingACurveDoNotHitItAgain) {
 
 // Builds a scene from text; null (and the diagnostics) on error.
 std::unique_ptr<Scene> sceneFrom(const std::string& world, Diagnostics& diag) {
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
-    std::string text = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n"
-                       "LightSource \"infinite\"\n" + world + "\nWorldEnd\n";
-    if (!parseString(text, "curves.pbrt", builder, diag)) return nullptr;
-    SceneDesc desc = builder.takeDesc();
-    return buildScene(desc, BuildOptions(), diag);
+    return test::sceneFromText("LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                               "LightSource \"infinite\"\n" + world + "\nWorldEnd\n",
+                               "curves.pbrt", diag);
 }
 
 TEST(Curves, SceneHitsCurvesInTheWorldAndInInstances) {

@@ -19,6 +19,7 @@
 #include "render/sampling.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -91,14 +92,9 @@ WorldEnd
 )";
 
 std::unique_ptr<Scene> buildPlane(int maxDepth = 2) {
-    Diagnostics diag;
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
     char text[1024];
     std::snprintf(text, sizeof(text), kPlane, maxDepth);
-    EXPECT_TRUE(parseString(text, "plane.pbrt", builder, diag));
-    SceneDesc desc = builder.takeDesc();
-    auto scene = buildScene(desc, BuildOptions(), diag);
+    auto scene = test::sceneFromText(text, "plane.pbrt");
     EXPECT_NE(scene, nullptr);
     return scene;
 }

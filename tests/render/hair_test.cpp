@@ -15,6 +15,7 @@
 #include "render/sampling.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -144,17 +145,13 @@ TEST(Hair, AbsorptionFromPigmentsAndColour) {
 
 TEST(Hair, MaterialOnACurve) {
     Diagnostics diag;
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
-    std::string text =
+    auto scene = test::sceneFromText(
         "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n"
         "LightSource \"infinite\"\n"
         "Material \"hair\" \"float eumelanin\" 0.3 \"rgb sigma_a\" [0.1 0.2 0.3]\n"
         "Shape \"curve\" \"string type\" \"cylinder\" \"point P\" [-1 0 0 -0.3333 0 0 "
-        "0.3333 0 0 1 0 0] \"float width\" 0.2\nWorldEnd\n";
-    ASSERT_TRUE(parseString(text, "hair.pbrt", builder, diag));
-    SceneDesc desc = builder.takeDesc();
-    auto scene = buildScene(desc, BuildOptions(), diag);
+        "0.3333 0 0 1 0 0] \"float width\" 0.2\nWorldEnd\n",
+        "hair.pbrt", diag);
     ASSERT_NE(scene, nullptr);
     EXPECT_EQ(diag.warningCount(), 1);  // eumelanin is ignored: sigma_a is given
     SurfaceInteraction si;

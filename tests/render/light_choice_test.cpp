@@ -14,6 +14,7 @@
 #include "render/light_sampler.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -161,14 +162,9 @@ TEST(MixedLightChoice, SceneGroupsTheTrianglesOfOneEmitter) {
     const std::string quad = "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] "
                              "\"point P\" [0 0 0  1 0 0  1 1 0  0 1 0]\n";
     auto build = [](const std::string& world) {
-        Diagnostics diag;
-        diag.setStream(nullptr);
-        SceneBuilder builder(diag);
-        const std::string text = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n" +
-                                 world + "WorldEnd\n";
-        EXPECT_TRUE(parseString(text, "groups.pbrt", builder, diag));
-        SceneDesc desc = builder.takeDesc();
-        return buildScene(desc, BuildOptions(), diag);
+        return test::sceneFromText(
+            "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n" + world + "WorldEnd\n",
+            "groups.pbrt");
     };
     const std::string lit = "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n";
     auto one = build("AttributeBegin\n" + lit + quad + "AttributeEnd\n");

@@ -17,6 +17,7 @@
 #include "render/integrator.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -45,12 +46,7 @@ WorldEnd
 )";
 
 std::unique_ptr<Scene> buildTestScene() {
-    Diagnostics diag;
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
-    EXPECT_TRUE(parseString(kScene, "patches.pbrt", builder, diag));
-    SceneDesc desc = builder.takeDesc();
-    auto scene = buildScene(desc, BuildOptions(), diag);
+    auto scene = test::sceneFromText(kScene, "patches.pbrt");
     EXPECT_NE(scene, nullptr);
     return scene;
 }

@@ -11,6 +11,7 @@
 #include "render/render.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -35,15 +36,10 @@ WorldEnd
 )";
 
 std::unique_ptr<Scene> build(const char* text, int spp, uint64_t seed) {
-    Diagnostics diag;
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
-    EXPECT_TRUE(parseString(text, "box.pbrt", builder, diag));
-    SceneDesc desc = builder.takeDesc();
     BuildOptions bo;
     bo.sppOverride = spp;
     bo.seed = seed;
-    auto scene = buildScene(desc, bo, diag);
+    auto scene = test::sceneFromText(text, "box.pbrt", bo);
     EXPECT_NE(scene, nullptr);
     return scene;
 }

@@ -22,6 +22,7 @@
 #include "render/resume.h"
 #include "render/scene.h"
 #include "render/scene_builder.h"
+#include "scene_text.h"
 
 namespace rlpbrt {
 namespace {
@@ -55,14 +56,9 @@ std::string room(bool fog, bool secondEmitter, int spp = 16) {
 }
 
 std::unique_ptr<Scene> build(const std::string& text) {
-    Diagnostics diag;
-    diag.setStream(nullptr);
-    SceneBuilder builder(diag);
-    EXPECT_TRUE(parseString(text, "room.pbrt", builder, diag));
-    SceneDesc desc = builder.takeDesc();
     BuildOptions bo;
     bo.seed = 5;
-    auto scene = buildScene(desc, bo, diag);
+    auto scene = test::sceneFromText(text, "room.pbrt", bo);
     EXPECT_NE(scene, nullptr);
     return scene;
 }
