@@ -429,7 +429,7 @@ uint64_t minItemBytes(const Element& e, Format f) {
 bool skipItem(BodyReader& r, const Element& e) {
     for (const Property& p : e.props) {
         if (p.isList) {
-            int64_t n;
+            int64_t n = 0;
             if (!r.readInt(p.countType, &n)) return false;
             if (n < 0) return r.fail("negative list count in element " + quoted(e.name));
             if (!r.skip(p.type, uint64_t(n))) return false;
