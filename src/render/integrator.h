@@ -95,9 +95,10 @@ struct GuideSettings {
     // (docs/STABILITY.md). Independent sets are exactly unbiased.
     bool independentPasses = false;
     // auto=N (render loop): after about N samples per pixel (or a quarter of a time budget),
-    // render one plain pass as large as the guided pass before it, compare the two passes'
-    // costs (relative variance per sample, render/efficiency.h, times CPU seconds per sample
-    // with a time budget: a render of fixed spp stays a function of its seed) and render the rest without guiding (no lookups, no learning) if the guided cost
+    // render a plain pass as large as the guided pass before it (in two parts: render.cpp),
+    // compare the two passes' costs (relative variance per sample, render/efficiency.h, times
+    // CPU seconds per sample with a time budget: a render of fixed spp stays a function of its
+    // seed) and render the rest without guiding (no lookups, no learning) if the guided cost
     // exceeds the plain one; where guiding stays, the plain pass's samples weigh as a guided
     // sample's variance against theirs. 0 = always guide, the default: with auto=64 two 30-s
     // studies gained on metal-spheres and buddha-fractal and lost 3-15% on most other scenes

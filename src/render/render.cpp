@@ -166,6 +166,13 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // The pixel means of the passes before the trial: the trial's reference values.
     std::unique_ptr<PassMoments> history =
         trial == Trial::Pending ? std::make_unique<PassMoments>(film.sampleBounds()) : nullptr;
+    // The trial over (decided, no room for it, or a resumed state that does not fit).
+    auto endTrial = [&] {
+        trial = Trial::Done;
+        guidedMoments.reset();
+        plainMoments.reset();
+        history.reset();
+    };
     double guidedSecondsPerSample = 0.0;
     int guidedCount = 0;
     double plainSeconds = 0.0;  // CPU seconds of the plain pass's parts so far
@@ -228,20 +235,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 : snap->trial == 3 ? Trial::MeasurePlainRest
                                    : Trial::Done;
         if (trial == Trial::Done || !history || !history->setState(snap->trialHistory))
-            trial = Trial::Done, history.reset();
+            endTrial();
         if (trial == Trial::MeasurePlain || trial == Trial::MeasurePlainRest) {
             guidedMoments = std::make_unique<PassMoments>(film.sampleBounds());
             guidedSecondsPerSample = snap->trialGuidedSecondsPerSample;
             guidedCount = snap->trialGuidedCount;
-            if (!guidedMoments->setState(snap->trialGuided))
-                trial = Trial::Done, history.reset(), guidedMoments.reset();
+            if (!guidedMoments->setState(snap->trialGuided)) endTrial();
         }
         if (trial == Trial::MeasurePlainRest) {
             plainMoments = std::make_unique<PassMoments>(film.sampleBounds());
             plainSeconds = snap->trialPlainSeconds;
             plainCount = snap->trialPlainCount;
-            if (!plainMoments->setState(snap->trialPlain))
-                trial = Trial::Done, history.reset(), guidedMoments.reset(), plainMoments.reset();
+            if (!plainMoments->setState(snap->trialPlain)) endTrial();
         }
         // The state holds every rank's pixels: each rank keeps its own until the trial sums them.
         if (ranks)
@@ -288,12 +293,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         sum.emplace(m);
         sum->sumAcross(*ranks);
         return *sum;
-    };
-    auto endTrial = [&] {
-        trial = Trial::Done;
-        guidedMoments.reset();
-        plainMoments.reset();
-        history.reset();
     };
     // The auto trial's verdict after its plain pass, or after the first part of it (partial:
     // the rest may follow); passSpp of the plain samples are in this pass's tiles, not yet

@@ -113,6 +113,7 @@ TEST(GuideFileCli, TheTrialRunsWhenAsked) {
         << json;
     EXPECT_NE(json.find("\"guide_auto_plain_cost\""), std::string::npos) << json;
     EXPECT_NE(json.find("\"guide_auto_plain_spp\": 6"), std::string::npos) << json;
+    // auto=0, and the default, never run it.
     for (const char* always : {"--guide=vdb --guide-param auto=0", "--guide=hemi"}) {
         CliRun guided = run(a + always);
         ASSERT_EQ(guided.status, 0) << guided.output;
