@@ -96,22 +96,6 @@ void trainSpot(HemiField& f, int region, const glm::vec3& xc, const glm::vec3& s
     }
 }
 
-chi2::SphereResult sphereAt(const GuidingField& f, int region, const glm::vec3& x,
-                            uint64_t seed) {
-    chi2::SphereOptions opt;
-    opt.sampleCount = 200000;
-    opt.thetaRes = 24;
-    opt.phiRes = 48;
-    opt.seed = seed;
-    return chi2::testSphere(
-        [&](const glm::vec3& u) {
-            chi2::SphereSample s;
-            s.dir = f.sampleAt(region, x, glm::vec2(u.x, u.y), u.z, &s.pdf);
-            return s;
-        },
-        [&](const glm::vec3& w) { return f.pdfAt(region, x, w); }, opt);
-}
-
 TEST(HemiSpots, RefusedWithTreeDirections) {
     GuideConfig cfg;
     cfg.backend = "hemi";
@@ -127,7 +111,7 @@ TEST(HemiSpots, UntrainedFieldIsTheStrata) {
     const glm::vec3 x(0.5f, 0.5f, 0.f), w = glm::normalize(glm::vec3(0.2f, 0.1f, 1.f));
     EXPECT_EQ(f->pdfAt(4, x, w), f->pdf(4, w));
     EXPECT_EQ(f->spots()->activeLobes(), 0u);
-    chi2::SphereResult r = sphereAt(*f, 4, x, 11);
+    chi2::SphereResult r = test::sphereTestAt(*f, 4, x, 11);
     EXPECT_TRUE(r.passed) << r.message;
     EXPECT_NEAR(r.pdfIntegral, 1.0, 2e-3);
 }
@@ -149,7 +133,7 @@ TEST(HemiSpots, TrainedLobesAimAtTheSpotAndMatchTheirPdf) {
     for (const glm::vec3& x : {xc, xc + glm::vec3(0.08f, 0.05f, 0.f)}) {
         const glm::vec3 toSpot = glm::normalize(spot - x);
         EXPECT_GT(f->pdfAt(region, x, toSpot), 20.f * f->pdf(region, toSpot));
-        chi2::SphereResult r = sphereAt(*f, region, x, 21);
+        chi2::SphereResult r = test::sphereTestAt(*f, region, x, 21);
         EXPECT_TRUE(r.passed) << r.message;
         EXPECT_NEAR(r.pdfIntegral, 1.0, 3e-3);
     }

@@ -122,25 +122,45 @@ void expectSameTables(const Field& a, const Field& b) {
                              a.cdfTable().size() * sizeof(float)));
 }
 
+inline chi2::SphereOptions sphereOptions(uint64_t seed, long long samples, int thetaRes,
+                                        int phiRes, int numTests = 1) {
+    chi2::SphereOptions opt;
+    opt.sampleCount = samples;
+    opt.thetaRes = thetaRes;
+    opt.phiRes = phiRes;
+    opt.seed = seed;
+    opt.numTests = numTests;
+    return opt;
+}
+
 // World-grid chi-square of a region's sample() against the quadrature of its pdf()
 // (render/chi2.h), 12 x 24 cells; numTests: the tests the 1% family-wise level is shared by.
 // The adaptive quadrature loses ~1e-5 of the mass of sharply peaked pdfs at discontinuities,
 // so peaked fields use 1e5 samples (bias ~1 count, below the ~sqrt(count) noise).
 inline chi2::SphereResult sphereTest(const GuidingField& f, int region, uint64_t seed,
                                      long long samples = 400000, int numTests = 1) {
-    chi2::SphereOptions opt;
-    opt.sampleCount = samples;
-    opt.thetaRes = 12;
-    opt.phiRes = 24;
-    opt.seed = seed;
-    opt.numTests = numTests;
     return chi2::testSphere(
         [&](const glm::vec3& u) {
             chi2::SphereSample s;
             s.dir = f.sample(region, glm::vec2(u.x, u.y), u.z, &s.pdf);
             return s;
         },
-        [&](const glm::vec3& w) { return f.pdf(region, w); }, opt);
+        [&](const glm::vec3& w) { return f.pdf(region, w); },
+        sphereOptions(seed, samples, 12, 24, numTests));
+}
+
+// The same at a place x of the region, through sampleAt() and pdfAt() (hemi's spot lobes aim
+// from x), on a finer 24 x 48 grid for narrow lobes.
+inline chi2::SphereResult sphereTestAt(const GuidingField& f, int region, const glm::vec3& x,
+                                       uint64_t seed, long long samples = 200000) {
+    return chi2::testSphere(
+        [&](const glm::vec3& u) {
+            chi2::SphereSample s;
+            s.dir = f.sampleAt(region, x, glm::vec2(u.x, u.y), u.z, &s.pdf);
+            return s;
+        },
+        [&](const glm::vec3& w) { return f.pdfAt(region, x, w); },
+        sphereOptions(seed, samples, 24, 48));
 }
 
 }  // namespace rlpbrt::guiding::test
