@@ -74,4 +74,37 @@ int sampleStrataCdf(const float* cdf, int n, float u) {
     return j;
 }
 
+int sampleStrataCdf2D(const float* cdf, int cols, int rows, glm::vec2 u, glm::vec2* cell) {
+    // The row: the first whose end exceeds u.x (rows of zero probability are skipped).
+    int lo = 0, hi = rows - 1;
+    while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (cdf[(mid + 1) * cols] > u.x) hi = mid;
+        else lo = mid + 1;
+    }
+    int row = lo;
+    // u.x at or above the last row's end (only by rounding): the last row of non-zero
+    // probability.
+    while (row > 0 && !(cdf[(row + 1) * cols] > cdf[row * cols])) --row;
+    const float* c = cdf + row * cols;
+    const float r0 = c[0], pr = c[cols] - c[0];
+    const float fx = pr > 0.f ? (u.x - r0) / pr : 0.f;
+    // The column: within the row's share of the CDF, at the fraction u.y of it.
+    const float t = r0 + u.y * pr;
+    lo = 0;
+    hi = cols - 1;
+    while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (c[mid + 1] > t) hi = mid;
+        else lo = mid + 1;
+    }
+    int col = lo;
+    while (col > 0 && !(c[col + 1] > c[col])) --col;
+    const float pc = c[col + 1] - c[col];
+    const float fy = pc > 0.f ? (t - c[col]) / pc : 0.f;
+    cell->x = std::clamp(fx, 0.f, 0.99999994f);
+    cell->y = std::clamp(fy, 0.f, 0.99999994f);
+    return row * cols + col;
+}
+
 }  // namespace rlpbrt::guiding

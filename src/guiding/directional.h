@@ -166,6 +166,19 @@ void buildStrataCdf(const double* q, int n, double epsilon, float* cdf);
 // (never a stratum of zero probability); clamped to n - 1 for u >= 1.
 int sampleStrataCdf(const float* cdf, int n, float u);
 
+// The same CDF over rows x cols strata in row-major order (a StrataLayout's hemisphere:
+// its rows() and cols(); its sphere: 2 rows() rows) inverted continuously in two dimensions,
+// as pbrt's Distribution2D: u.x picks the row by the rows' marginal and gives the position
+// in the row (cell.x), u.y picks the column by the row's conditional and gives the position
+// in the column (cell.y). The map is monotone and continuous inside each row, so a well
+// stratified set of u stays well stratified over the directions (a stratum picked by a
+// separate 1D value, with u placing the direction inside it, is not stratified jointly: on
+// killeroo-simple that cost guided sampling 7% more error per sample with the Sobol'
+// sampler). Stratum j is returned with probability strataProbability(cdf, j), as by
+// sampleStrataCdf, and cell (in [0,1)^2) is uniform in it; never a stratum of zero
+// probability.
+int sampleStrataCdf2D(const float* cdf, int cols, int rows, glm::vec2 u, glm::vec2* cell);
+
 // Probability of stratum j under the CDF (cdf[j+1] - cdf[j]): exactly the measure of the u
 // values sampleStrataCdf maps to j.
 inline float strataProbability(const float* cdf, int j) { return cdf[j + 1] - cdf[j]; }

@@ -33,9 +33,9 @@ void GuidingField::setPatches(uint32_t, std::function<bool(uint32_t, glm::vec3*,
 
 void GuidingField::requestMedium(int, const glm::vec3&) {}
 
-glm::vec3 GuidingField::sampleAt(int region, const glm::vec3&, glm::vec2 u, float uStratum,
+glm::vec3 GuidingField::sampleAt(int region, const glm::vec3&, glm::vec2 u, float uPick,
                                  float* pdf, int* bin) const {
-    return sample(region, u, uStratum, pdf, bin);
+    return sample(region, u, uPick, pdf, bin);
 }
 float GuidingField::pdfAt(int region, const glm::vec3&, const glm::vec3& w, int* bin) const {
     return pdf(region, w, bin);

@@ -153,11 +153,14 @@ public:
 
     // ---- The policy of a region (what VertexGuide reads). Every call accepts -1 (an
     // invalid region) and medium regions.
-    // Samples a unit world direction from the frozen policy of `region` (u places it inside
-    // the stratum chosen by uStratum; all in [0,1)); *pdf is per steradian and equals
-    // pdf(region, result) (> 0 for a valid region; 0 and a zero vector for an invalid one).
-    // *bin (if given) receives the result's bin, as pdf() does.
-    virtual glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
+    // Samples a unit world direction from the frozen policy of `region`; all values in [0,1).
+    // u places the direction: a backend with a table of strata picks the stratum and the
+    // position in it from u alone, continuously (sampleStrataCdf2D), so that the sampler's
+    // 2D stratification carries over to the directions; uPick chooses among the parts of a
+    // mixture (hemi's spot lobes) or a tree's leaf (directions=tree). *pdf is per steradian
+    // and equals pdf(region, result) (> 0 for a valid region; 0 and a zero vector for an
+    // invalid one). *bin (if given) receives the result's bin, as pdf() does.
+    virtual glm::vec3 sample(int region, glm::vec2 u, float uPick, float* pdf,
                              int* bin = nullptr) const = 0;
     // Solid-angle pdf of sample() for any world direction (0 outside the region's hemisphere
     // and for an invalid region); w need not be normalised. *bin (if given) receives w's bin
@@ -167,7 +170,7 @@ public:
     // sample() and pdf() for a vertex at x in the region: a backend whose distribution
     // depends on the vertex's position (hemi's spot lobes aim at points) answers here; the
     // defaults are sample() and pdf(). VertexGuide calls these.
-    virtual glm::vec3 sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uStratum,
+    virtual glm::vec3 sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uPick,
                                float* pdf, int* bin = nullptr) const;
     virtual float pdfAt(int region, const glm::vec3& x, const glm::vec3& w,
                         int* bin = nullptr) const;
@@ -320,8 +323,8 @@ public:
     GuidingField::Choice choice() const {
         return field_ ? field_->choice(region_) : GuidingField::Choice();
     }
-    glm::vec3 sample(glm::vec2 u, float uStratum, float* pdf, int* bin = nullptr) const {
-        return field_->sampleAt(region_, p_, u, uStratum, pdf, bin);
+    glm::vec3 sample(glm::vec2 u, float uPick, float* pdf, int* bin = nullptr) const {
+        return field_->sampleAt(region_, p_, u, uPick, pdf, bin);
     }
     float pdf(const glm::vec3& w, int* bin = nullptr) const {
         return field_->pdfAt(region_, p_, w, bin);

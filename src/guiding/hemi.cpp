@@ -249,7 +249,7 @@ float HemiField::pdf(int region, const glm::vec3& w, int* bin) const {
     return strataProbability(cdf(region), j) * layout_.density();
 }
 
-glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut,
+glm::vec3 HemiField::sample(int region, glm::vec2 u, float uPick, float* pdfOut,
                             int* bin) const {
     if (!validRegion(region)) {
         *pdfOut = 0.f;
@@ -258,7 +258,7 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfO
     }
     if (trees_) {
         float d = 0.f;
-        const glm::vec2 a = trees_->sample(size_t(region), u, uStratum, &d);
+        const glm::vec2 a = trees_->sample(size_t(region), u, uPick, &d);
         const glm::vec3 w = glm::normalize(
             frames_[size_t(region)].frame.toWorld(DirTree::hemisphereDirection(a)));
         // The pdf of the direction as pdf() finds it (the round trip through the frame may
@@ -269,11 +269,12 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uStratum, float* pdfO
         return w;
     }
     const float* c = cdf(region);
-    int j = sampleStrataCdf(c, strata_, uStratum);
+    const int j = sampleStrataCdf2D(c, layout_.cols(), layout_.rows(), u, &u);
     glm::vec3 w = glm::normalize(frames_[size_t(region)].frame.toWorld(layout_.sampleStratum(j, u)));
     const float density = strataProbability(c, j) * layout_.density();
     // Report exactly pdf(region, w), so that MIS weights computed later agree; rounding may
-    // move a direction on a stratum edge to its neighbour. Away from the edges (u at least
+    // move a direction on a stratum edge to its neighbour. Away from the edges (u, now the
+    // position in the stratum, at least
     // kEdge inside, so that with up to 64x64 strata w is at least 1.5e-5 in cos(theta) and
     // 9e-5 rad in phi from an edge, and at least 5e-3 from the pole: a hundred times the
     // rounding of the frame's round trip) w's stratum is j, without finding it again. On the
@@ -300,15 +301,15 @@ float HemiField::pdfAt(int region, const glm::vec3& x, const glm::vec3& w, int* 
     return (1.f - s) * p + s * spots_->pdf(region, x, unit);
 }
 
-glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uStratum,
+glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uPick,
                               float* pdfOut, int* bin) const {
     const float s = spots_ ? spots_->share(region) : 0.f;
-    if (!(s > 0.f)) return sample(region, u, uStratum, pdfOut, bin);
+    if (!(s > 0.f)) return sample(region, u, uPick, pdfOut, bin);
     // One-sample mixture: the lobes with probability s, else the strata; the density is the
     // mixture's.
     glm::vec3 w;
-    if (uStratum < s) {
-        w = spots_->sample(region, x, u, std::min(uStratum / s, 0.99999994f));
+    if (uPick < s) {
+        w = spots_->sample(region, x, u, std::min(uPick / s, 0.99999994f));
         if (!(glm::dot(w, w) > 0.f)) {
             *pdfOut = 0.f;
             if (bin) *bin = -1;
@@ -322,7 +323,7 @@ glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float
         return w;
     }
     float ps = 0.f;
-    w = sample(region, u, std::min((uStratum - s) / (1.f - s), 0.99999994f), &ps, bin);
+    w = sample(region, u, std::min((uPick - s) / (1.f - s), 0.99999994f), &ps, bin);
     *pdfOut = (1.f - s) * ps + s * spots_->pdf(region, x, w);
     return w;
 }

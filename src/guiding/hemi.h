@@ -116,10 +116,10 @@ public:
     float patchSize() const override;
     void setPatches(uint32_t count,
                     std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> centre) override;
-    glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
+    glm::vec3 sample(int region, glm::vec2 u, float uPick, float* pdf,
                      int* bin = nullptr) const override;
     float pdf(int region, const glm::vec3& w, int* bin = nullptr) const override;
-    glm::vec3 sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uStratum,
+    glm::vec3 sampleAt(int region, const glm::vec3& x, glm::vec2 u, float uPick,
                        float* pdf, int* bin = nullptr) const override;
     float pdfAt(int region, const glm::vec3& x, const glm::vec3& w,
                 int* bin = nullptr) const override;

@@ -393,18 +393,20 @@ float VdbField::pdf(int region, const glm::vec3& w, int* bin) const {
     return strataProbability(table_.cdf(size_t(region)), j) * layout_.density();
 }
 
-glm::vec3 VdbField::sample(int region, glm::vec2 u, float uStratum, float* pdfOut,
+glm::vec3 VdbField::sample(int region, glm::vec2 u, float /*uPick*/, float* pdfOut,
                            int* bin) const {
     if (bin) *bin = -1;
     if (const int cell = volumeCell(region); cell >= 0)
-        return volume_->sample(cell, u, uStratum, pdfOut);
+        return volume_->sample(cell, u, pdfOut);
     if (!validRegion(region)) {
         *pdfOut = 0.f;
         return glm::vec3(0.f);
     }
     const float* c = table_.cdf(size_t(region));
-    const int j = sampleStrataCdf(c, table_.strata(), uStratum);
-    glm::vec3 local = layout_.sampleSphereStratum(j, u);
+    glm::vec2 cell;
+    const int cols = layout_.cols();
+    const int j = sampleStrataCdf2D(c, cols, table_.strata() / cols, u, &cell);
+    glm::vec3 local = layout_.sampleSphereStratum(j, cell);
     glm::vec3 w = glm::normalize(frames_[size_t(region)].toWorld(local));
     // Report exactly pdf(region, w) (rounding may move w across a stratum edge); on the
     // hemisphere's rim (pdf 0) keep the drawn stratum's density, as hemi does.

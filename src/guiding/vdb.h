@@ -75,7 +75,7 @@ public:
     int lookupSurface(const glm::vec3& p, const glm::vec3& n) const;
     int lookupVolume(const glm::vec3& p) const;
     void requestMedium(int slot, const glm::vec3& p) override;
-    glm::vec3 sample(int region, glm::vec2 u, float uStratum, float* pdf,
+    glm::vec3 sample(int region, glm::vec2 u, float uPick, float* pdf,
                      int* bin = nullptr) const override;
     float pdf(int region, const glm::vec3& w, int* bin = nullptr) const override;
     float scatteredEstimate(int region,

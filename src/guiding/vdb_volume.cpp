@@ -72,14 +72,16 @@ float VdbVolume::pdf(int cell, const glm::vec3& w) const {
     return strataProbability(table_.cdf(size_t(cell)), j) * layout_.density();
 }
 
-glm::vec3 VdbVolume::sample(int cell, glm::vec2 u, float uStratum, float* pdfOut) const {
+glm::vec3 VdbVolume::sample(int cell, glm::vec2 u, float* pdfOut) const {
     if (cell < 0 || cell >= cells()) {
         *pdfOut = 0.f;
         return glm::vec3(0.f);
     }
     const float* c = table_.cdf(size_t(cell));
-    const int j = sampleStrataCdf(c, table_.strata(), uStratum);
-    const glm::vec3 w = glm::normalize(layout_.sampleSphereStratum(j, u));
+    glm::vec2 pos;
+    const int cols = layout_.cols();
+    const int j = sampleStrataCdf2D(c, cols, table_.strata() / cols, u, &pos);
+    const glm::vec3 w = glm::normalize(layout_.sampleSphereStratum(j, pos));
     // Report exactly pdf(cell, w); on the equator (measure zero) keep the drawn stratum's.
     float p = pdf(cell, w);
     if (!(p > 0.f)) p = strataProbability(c, j) * layout_.density();

@@ -55,7 +55,7 @@ public:
     int stratumOf(const glm::vec3& w) const;
     // The GuidingField operations for a cell in [0, cells()).
     float pdf(int cell, const glm::vec3& w) const;
-    glm::vec3 sample(int cell, glm::vec2 u, float uStratum, float* pdf) const;
+    glm::vec3 sample(int cell, glm::vec2 u, float* pdf) const;
     float radiance(int cell, const glm::vec3& w) const;
     // (2 pi / n) sum_j Q(cell, j) fcos(centre_j) over all 2n strata (GuidingField's contract).
     float scatteredEstimate(int cell, const std::function<float(const glm::vec3&)>& fcos) const;

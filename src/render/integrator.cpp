@@ -221,21 +221,26 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
         return ds;
     }
     // One-sample MIS: guide with probability mix, else the BSDF; the pdf is the mixture's.
+    // The choice is made by u.x, rescaled to [0,1) for the chosen strategy, so that either
+    // strategy's directions come from a well-stratified subset of the sampler's 2D points
+    // (uc, a separate dimension, picks the BSDF's lobe or the guide's mixture part). Choosing
+    // by uc took each strategy an unstratified random share of the 2D points: 5-7% more
+    // error per sample with the Sobol' sampler (killeroo-simple, cornell-box; session 31).
     const float mix = guideMix(guide);
     ds.scale = guide.scale;
     float pGuide = 0.f, pBsdf = 0.f;
-    if (uc < mix) {
-        float uStratum = std::min(uc / mix, OneMinusEpsilon);
+    if (u.x < mix) {
+        u.x = std::min(u.x / mix, OneMinusEpsilon);
         {
             GuideTimer timer(guide.clock);
-            ds.wi = guide.guide.sample(u, uStratum, &pGuide, &ds.bin);
+            ds.wi = guide.guide.sample(u, uc, &pGuide, &ds.bin);
         }
         if (!(pGuide > 0.f)) return DirectionSample();
         ds.f = bsdf.f(si.wo, ds.wi);
         pBsdf = bsdf.pdf(si.wo, ds.wi);
     } else {
-        float ub = std::min((uc - mix) / (1.f - mix), OneMinusEpsilon);
-        BSDFSample bs = bsdf.sampleF(si.wo, ub, u);
+        u.x = std::min((u.x - mix) / (1.f - mix), OneMinusEpsilon);
+        BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
         if (!bs.valid()) return DirectionSample();
         ds.wi = bs.wi;
         ds.f = bs.f;
@@ -344,19 +349,22 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
                                                                       GuideMixture& guide,
                                                                       Sampler& sampler) const {
     DirectionSample ds;
-    const float uc = guide_.field ? sampler.get1D() : 1.f;
-    const Vec2 u = sampler.get2D();
+    const float uc = guide_.field ? sampler.get1D() : 0.f;
+    Vec2 u = sampler.get2D();
     const float mix = guideMix(guide);
     ds.scale = guide.scale;
     float pGuide = 0.f, pPhase = 0.f;
-    if (uc < mix) {
+    // The guide or the phase function by u.x, as sampleDirection does.
+    if (u.x < mix) {
+        u.x = std::min(u.x / mix, OneMinusEpsilon);
         {
             GuideTimer timer(guide.clock);
-            ds.wi = guide.guide.sample(u, std::min(uc / mix, OneMinusEpsilon), &pGuide, &ds.bin);
+            ds.wi = guide.guide.sample(u, uc, &pGuide, &ds.bin);
         }
         if (!(pGuide > 0.f)) return DirectionSample();
         pPhase = henyeyGreenstein(glm::dot(wo, ds.wi), g);
     } else {
+        u.x = std::min((u.x - mix) / (1.f - mix), OneMinusEpsilon);
         ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
         if (!(pPhase > 0.f)) return DirectionSample();
         if (mix > 0.f) {

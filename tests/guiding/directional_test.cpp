@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "render/chi2.h"
@@ -151,6 +152,77 @@ TEST(StrataCdf, SampleFrequenciesMatchProbabilities) {
     for (int j = 0; j < 8; ++j) expected[size_t(j)] = n * double(strataProbability(cdf.data(), j));
     chi2::Result r = chi2::testCounts(observed, expected);
     EXPECT_TRUE(r.passed) << r.message;
+}
+
+// 4 columns x 3 rows, row-major, with a zero stratum and a zero row (the middle one).
+std::vector<float> grid2dCdf() {
+    const std::vector<double> q = {1.0, 5.0, 0.0, 2.0,  0.0, 0.0, 0.0, 0.0,  8.0, 0.5, 1.0, 3.0};
+    std::vector<float> cdf(13);
+    buildStrataCdf(q.data(), 12, 0.0, cdf.data());
+    return cdf;
+}
+
+TEST(StrataCdf2D, StrataAndPositionsFollowTheProbabilities) {
+    const std::vector<float> cdf = grid2dCdf();
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    const int n = 200000;
+    // Counts per stratum, and per (stratum, quarter of cell.x), (stratum, quarter of cell.y):
+    // uniform positions put a quarter of a stratum's samples in each.
+    std::vector<double> observed(12, 0.0), expected(12), ox(48, 0.0), oy(48, 0.0), e4(48);
+    for (int i = 0; i < n; ++i) {
+        glm::vec2 cell;
+        const int j = sampleStrataCdf2D(cdf.data(), 4, 3, glm::vec2(uni(rng), uni(rng)), &cell);
+        ASSERT_TRUE(j >= 0 && j < 12);
+        ASSERT_TRUE(cell.x >= 0.f && cell.x < 1.f && cell.y >= 0.f && cell.y < 1.f);
+        observed[size_t(j)] += 1;
+        ox[size_t(j * 4 + int(cell.x * 4.f))] += 1;
+        oy[size_t(j * 4 + int(cell.y * 4.f))] += 1;
+    }
+    for (int j = 0; j < 12; ++j) {
+        expected[size_t(j)] = n * double(strataProbability(cdf.data(), j));
+        for (int k = 0; k < 4; ++k) e4[size_t(j * 4 + k)] = expected[size_t(j)] / 4.0;
+    }
+    for (int j : {2, 4, 5, 6, 7}) EXPECT_EQ(observed[size_t(j)], 0.0) << j;
+    for (const auto& [obs, exp] : {std::pair(&observed, &expected), std::pair(&ox, &e4),
+                                   std::pair(&oy, &e4)}) {
+        chi2::Result r = chi2::testCounts(*obs, *exp);
+        EXPECT_TRUE(r.passed) << r.message;
+    }
+}
+
+TEST(StrataCdf2D, NeverSelectsZeroProbabilityStrataAtTheEdges) {
+    const std::vector<float> cdf = grid2dCdf();
+    for (float ux : {0.f, 1e-9f, 0.5f, 0.99999994f, 1.f})
+        for (float uy : {0.f, 1e-9f, 0.5f, 0.99999994f, 1.f}) {
+            glm::vec2 cell;
+            const int j = sampleStrataCdf2D(cdf.data(), 4, 3, glm::vec2(ux, uy), &cell);
+            EXPECT_GT(strataProbability(cdf.data(), j), 0.f) << ux << " " << uy;
+            EXPECT_TRUE(cell.x >= 0.f && cell.x < 1.f && cell.y >= 0.f && cell.y < 1.f);
+        }
+}
+
+// The property it is for: inside a row the map is linear in u.x (the row's marginal) and, for
+// a given u.x, monotone in u.y, so neighbouring u stay neighbouring directions.
+TEST(StrataCdf2D, ContinuousAndMonotoneInsideARow) {
+    const std::vector<float> cdf = grid2dCdf();
+    const float r0 = cdf[8], pr = cdf[12] - cdf[8];  // the last row
+    glm::vec2 a, b;
+    const int ja = sampleStrataCdf2D(cdf.data(), 4, 3, glm::vec2(r0 + 0.2f * pr, 0.3f), &a);
+    const int jb = sampleStrataCdf2D(cdf.data(), 4, 3, glm::vec2(r0 + 0.7f * pr, 0.3f), &b);
+    EXPECT_EQ(ja, jb);
+    EXPECT_NEAR(a.x, 0.2f, 1e-5f);
+    EXPECT_NEAR(b.x, 0.7f, 1e-5f);
+    EXPECT_EQ(a.y, b.y);  // the column's position depends on u.y only
+    int lastKey = -1;
+    for (int i = 0; i < 1000; ++i) {
+        glm::vec2 c;
+        const int j = sampleStrataCdf2D(cdf.data(), 4, 3, glm::vec2(r0 + 0.5f * pr, i / 1000.f), &c);
+        ASSERT_EQ(j / 4, 2);
+        const int key = j * 1000000 + int(c.y * 999999.f);
+        EXPECT_GE(key, lastKey) << i;
+        lastKey = key;
+    }
 }
 
 TEST(Frame, OrthonormalAndInverse) {
