@@ -58,8 +58,17 @@ Spectrum BSDF::f(const Vec3& woWorld, const Vec3& wiWorld, BxDFFlags flags) cons
 BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags) const {
     int matching = numComponents(flags);
     if (matching == 0) return BSDFSample();
-    // Choose the matching lobe; its share of uc is rescaled to [0,1) for the lobe itself.
-    int comp = std::min(static_cast<int>(uc * matching), matching - 1);
+    // Choose the matching lobe by u.x, rescaled to [0,1) for the lobe (pbrt-v3's remapping):
+    // each lobe's directions then come from a well-stratified part of the sampler's 2D
+    // points. Chosen by uc, each lobe took an unstratified random share of them: with the
+    // Sobol' sampler 3-17% more error per sample on scenes of several lobes per BSDF
+    // (caustic-glass 17%, killeroo-simple 9%, veach-mis 6-9%, metal-spheres 3%; session 31).
+    // uc goes to the lobe for its own choice (a dielectric's reflection or transmission).
+    int comp = 0;
+    if (matching > 1) {
+        comp = std::min(static_cast<int>(u.x * matching), matching - 1);
+        u.x = std::min(u.x * matching - comp, OneMinusEpsilon);
+    }
     const BxDF* chosen = nullptr;
     int chosenIndex = -1;
     for (int i = 0, count = comp; i < n_; ++i) {
@@ -69,11 +78,10 @@ BSDFSample BSDF::sampleF(const Vec3& woWorld, float uc, Vec2 u, BxDFFlags flags)
             break;
         }
     }
-    float ucRemapped = std::min(uc * matching - comp, OneMinusEpsilon);
 
     Vec3 wo = worldToLocal(woWorld);
     if (wo.z == 0.f) return BSDFSample();
-    BxDFSample ls = chosen->sampleF(wo, ucRemapped, u);
+    BxDFSample ls = chosen->sampleF(wo, uc, u);
     if (!(ls.pdf > 0.f)) return BSDFSample();
 
     BSDFSample s;

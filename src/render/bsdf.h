@@ -98,9 +98,10 @@ class BSDF {
     // or transmission lobes are evaluated (pbrt-v3). Specular lobes contribute 0.
     Spectrum f(const Vec3& woWorld, const Vec3& wiWorld,
                BxDFFlags flags = BxDFFlags::All) const;
-    // Samples an incident direction: picks one of the matching lobes uniformly with uc (the
-    // remainder of uc is passed on to the lobe), samples it with u; for non-specular lobes pdf
-    // averages all matching lobes' pdfs (solid angle) and f sums all matching lobes.
+    // Samples an incident direction: picks one of the matching lobes uniformly with u.x
+    // (whose remainder, rescaled to [0,1), the lobe then samples with u.y), passes uc on to
+    // the lobe for its own choice; for non-specular lobes pdf averages all matching lobes'
+    // pdfs (solid angle) and f sums all matching lobes.
     BSDFSample sampleF(const Vec3& woWorld, float uc, Vec2 u,
                        BxDFFlags flags = BxDFFlags::All) const;
     // Solid-angle density of sampleF for non-specular lobes (average over matching lobes).
