@@ -277,10 +277,9 @@ Spectrum PathIntegrator::sampleLight(const SurfaceInteraction& si, const BSDF& b
                                      const guiding::GuidingField::Choice& choice,
                                      PathRecorder* rec,
                                      const guiding::VertexGuide* region) const {
-    float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
     float pmf;
-    const int li = lightChoice(choice).sample(si.p, uLight, &pmf);
+    const int li = lightChoice(choice).sample(si.p, u.x, &pmf, &u.x);
     if (li < 0 || pmf == 0.f) return Spectrum(0.f);
     // What the shadow ray found for the learned choice: Le f cos / pdf where the light is
     // visible, 0 where not (before the selection's probability and the MIS weight), over the
@@ -383,10 +382,9 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
 Spectrum PathIntegrator::sampleLightMedium(const Vec3& p, const Vec3& wo, float g,
                                            GuideMixture& guide, const PathMedium& pm,
                                            Sampler& sampler, PathStats& stats) const {
-    float uLight = sampler.get1D();
     Vec2 u = sampler.get2D();
     float pmf;
-    int li = lights_->sample(p, uLight, &pmf);
+    int li = lights_->sample(p, u.x, &pmf, &u.x);
     if (li < 0 || pmf == 0.f) return Spectrum(0.f);
     const Light& light = *scene_.lights[size_t(li)];
     LightSample ls;

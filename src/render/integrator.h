@@ -209,6 +209,11 @@ private:
     };
     // choice: the vertex's learned light choice (GuidingField::choice; none: the scene's
     // light sampler alone); with rec, what the shadow ray found is recorded for `region`.
+    // One 2D sample: u.x chooses the light and, rescaled to its share, places the point on
+    // it with u.y, so each light's points keep the sampler's 2D stratification (a separate
+    // 1D choice gave each light an unstratified share: with the Sobol' sampler 4-10% more
+    // error per sample on caustic-glass, conference-room and veach-mis; session 31). A light
+    // of probability p keeps 24 + log2(p) bits of u.x.
     Spectrum sampleLight(const SurfaceInteraction& si, const BSDF& bsdf, GuideMixture& guide,
                          Sampler& sampler, PathStats& stats, const PathMedium* media = nullptr,
                          const guiding::GuidingField::Choice& choice = {},

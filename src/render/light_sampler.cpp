@@ -13,6 +13,12 @@ LightSampler::~LightSampler() = default;
 
 namespace {
 
+// u's place in [lo, hi), rescaled to [0,1).
+float remapped(float u, float lo, float hi) {
+    const float w = hi - lo;
+    return w > 0.f ? clamp((u - lo) / w, 0.f, OneMinusEpsilon) : 0.f;
+}
+
 // Radical inverse of i in the baseIndex-th prime (Halton points inside a voxel).
 float haltonCoordinate(int baseIndex, uint32_t i) {
     static const uint32_t primes[] = {2, 3, 5, 7, 11};
@@ -29,8 +35,8 @@ float powerWeight(const Light& light) {
 class TableLightSampler : public LightSampler {
 public:
     explicit TableLightSampler(const std::vector<float>& w) : dist_(w) {}
-    int sample(const Vec3&, float u, float* pmf) const override {
-        return dist_.sampleDiscrete(u, pmf);
+    int sample(const Vec3&, float u, float* pmf, float* uRemapped = nullptr) const override {
+        return dist_.sampleDiscrete(u, pmf, uRemapped);
     }
     float pmf(const Vec3&, int light) const override { return dist_.discretePmf(light); }
 
@@ -40,8 +46,9 @@ private:
 
 class NoLightSampler : public LightSampler {
 public:
-    int sample(const Vec3&, float, float* pmf) const override {
+    int sample(const Vec3&, float, float* pmf, float* uRemapped = nullptr) const override {
         *pmf = 0.f;
+        if (uRemapped) *uRemapped = 0.f;
         return -1;
     }
     float pmf(const Vec3&, int) const override { return 0.f; }
@@ -145,7 +152,7 @@ const float* SpatialLightSampler::lookup(const Vec3& p) const {
     return expected;
 }
 
-int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf) const {
+int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf, float* uRemapped) const {
     const float* cdf = lookup(p);
     const int n = int(lights_.size());
     // Largest i with cdf[i] <= u, among pieces of non-zero probability.
@@ -153,6 +160,7 @@ int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf) const {
     i = clamp(i, 0, n - 1);
     while (i > 0 && cdf[n + 1 + i] == 0.f) --i;
     *pmf = cdf[n + 1 + i];
+    if (uRemapped) *uRemapped = remapped(u, cdf[i], cdf[i + 1]);
     return i;
 }
 
@@ -193,24 +201,25 @@ LightGroups::LightGroups(const std::vector<std::unique_ptr<Light>>& lights,
     }
 }
 
-int LightGroups::sample(int g, float u) const {
+int LightGroups::sample(int g, float u, float* uRemapped) const {
     const int b = first_[size_t(g)], e = first_[size_t(g) + 1];
     const auto it = std::upper_bound(cdf_.begin() + b, cdf_.begin() + e, u);
-    return members_[size_t(std::min(int(it - cdf_.begin()), e - 1))];
+    const int k = std::min(int(it - cdf_.begin()), e - 1);
+    if (uRemapped) *uRemapped = remapped(u, k > b ? cdf_[size_t(k) - 1] : 0.f, cdf_[size_t(k)]);
+    return members_[size_t(k)];
 }
 
-int MixedLightChoice::sample(const Vec3& p, float u, float* pmfOut) const {
-    if (!cdf || !(share > 0.f)) return base.sample(p, u, pmfOut);
+int MixedLightChoice::sample(const Vec3& p, float u, float* pmfOut, float* uRemapped) const {
+    if (!cdf || !(share > 0.f)) return base.sample(p, u, pmfOut, uRemapped);
     float known = -1.f;
     int light;
     if (u < share) {
         const float v = std::min(u / share, OneMinusEpsilon);
         const int g = guiding::sampleStrataCdf(cdf, groups.count(), v);
-        const float width = cdf[g + 1] - cdf[g];
-        const float w = width > 0.f ? std::clamp((v - cdf[g]) / width, 0.f, OneMinusEpsilon) : 0.f;
-        light = groups.sample(g, w);
+        light = groups.sample(g, remapped(v, cdf[g], cdf[g + 1]), uRemapped);
     } else {
-        light = base.sample(p, std::min((u - share) / (1.f - share), OneMinusEpsilon), &known);
+        light = base.sample(p, std::min((u - share) / (1.f - share), OneMinusEpsilon), &known,
+                            uRemapped);
     }
     *pmfOut = light >= 0 ? pmf(p, light, known) : 0.f;
     return *pmfOut > 0.f ? light : -1;

@@ -22,7 +22,9 @@ class LightSampler {
 public:
     virtual ~LightSampler();
     // Chooses a light for a receiving point p: its index and probability (pmf), or -1.
-    virtual int sample(const Vec3& p, float u, float* pmf) const = 0;
+    // uRemapped (if given): u's place within the light's share of [0,1), rescaled to [0,1)
+    // (uniform, independent of the choice), for the light's own sampling.
+    virtual int sample(const Vec3& p, float u, float* pmf, float* uRemapped = nullptr) const = 0;
     // The probability that sample() at p returns `light`.
     virtual float pmf(const Vec3& p, int light) const = 0;
 };
@@ -52,8 +54,9 @@ public:
     int group(int light) const { return of_[size_t(light)].group; }
     // The probability of `light` among its group's lights.
     float within(int light) const { return of_[size_t(light)].within; }
-    // A light of group g from u in [0,1), with probability within().
-    int sample(int g, float u) const;
+    // A light of group g from u in [0,1), with probability within(); uRemapped as
+    // LightSampler::sample's.
+    int sample(int g, float u, float* uRemapped = nullptr) const;
 
 private:
     // Per light, side by side (both are read for every shadow ray's pmf).
@@ -79,7 +82,8 @@ struct MixedLightChoice {
     const LightGroups& groups;
     float share;
     // A light for the receiving point p from u in [0,1), with its pmf; -1 (pmf 0) for none.
-    int sample(const Vec3& p, float u, float* pmf) const;
+    // uRemapped as LightSampler::sample's.
+    int sample(const Vec3& p, float u, float* pmf, float* uRemapped = nullptr) const;
     // The pmf of `light` at p; baseKnown >= 0: base.pmf(p, light), already looked up.
     float pmf(const Vec3& p, int light, float baseKnown = -1.f) const {
         if (!(baseKnown >= 0.f)) baseKnown = base.pmf(p, light);
@@ -95,7 +99,7 @@ public:
     SpatialLightSampler(const std::vector<std::unique_ptr<Light>>& lights, const Vec3& bMin,
                         const Vec3& bMax, int maxVoxels = 64);
     ~SpatialLightSampler() override;
-    int sample(const Vec3& p, float u, float* pmf) const override;
+    int sample(const Vec3& p, float u, float* pmf, float* uRemapped = nullptr) const override;
     float pmf(const Vec3& p, int light) const override;
     int voxelsComputed() const { return computed_.load(); }
 

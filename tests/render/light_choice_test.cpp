@@ -29,12 +29,14 @@ public:
         for (int i = 0; i < n_; ++i) total += 1.f + t * float(i);
         return (1.f + t * float(light)) / total;
     }
-    int sample(const Vec3& p, float u, float* pmf) const override {
+    int sample(const Vec3& p, float u, float* pmf, float* uRemapped = nullptr) const override {
         float acc = 0.f;
         for (int i = 0; i < n_; ++i) {
+            const float lo = acc;
             acc += this->pmf(p, i);
             if (u < acc || i == n_ - 1) {
                 *pmf = this->pmf(p, i);
+                if (uRemapped) *uRemapped = std::clamp((u - lo) / *pmf, 0.f, OneMinusEpsilon);
                 return i;
             }
         }
@@ -67,7 +69,8 @@ std::vector<std::unique_ptr<Light>> lightsOfPower(const std::vector<float>& w) {
 }
 
 // The mixture's pmf sums to 1 with every light above 0, and sample() follows it (chi-square),
-// for no CDF and a learned CDF over the groups, shares 0..0.8, and two points.
+// for no CDF and a learned CDF over the groups, shares 0..0.8, and two points; its remapped
+// u is uniform in [0,1) for each light (chi-square over quarters).
 void expectMixtureSamplesItsPmf(const LightSampler& base, const LightGroups& groups,
                                 const float* cdf, int n) {
     std::mt19937_64 rng(3);
@@ -79,6 +82,7 @@ void expectMixtureSamplesItsPmf(const LightSampler& base, const LightGroups& gro
                 double total = 0.0;
                 std::vector<double> expected(static_cast<size_t>(n));
                 std::vector<double> observed(expected.size(), 0.0);
+                std::vector<double> quarters(4 * expected.size(), 0.0), eq(quarters.size());
                 for (int l = 0; l < n; ++l) {
                     const float q = mix.pmf(p, l);
                     EXPECT_GT(q, 0.f) << l;  // every light keeps a chance
@@ -87,16 +91,23 @@ void expectMixtureSamplesItsPmf(const LightSampler& base, const LightGroups& gro
                 EXPECT_NEAR(total, 1.0, 1e-6);
                 constexpr int kSamples = 200000;
                 for (int i = 0; i < kSamples; ++i) {
-                    float pmf = 0.f;
-                    const int l = mix.sample(p, u01(rng), &pmf);
+                    float pmf = 0.f, ur = -1.f;
+                    const int l = mix.sample(p, u01(rng), &pmf, &ur);
                     ASSERT_GE(l, 0);
                     ASSERT_LT(l, n);
                     EXPECT_EQ(pmf, mix.pmf(p, l));
+                    ASSERT_TRUE(ur >= 0.f && ur < 1.f) << ur;
                     observed[size_t(l)] += 1.0;
+                    quarters[size_t(4 * l + int(ur * 4.f))] += 1.0;
                 }
-                for (int l = 0; l < n; ++l) expected[size_t(l)] = kSamples * mix.pmf(p, l);
-                const chi2::Result r = chi2::testCounts(observed, expected, 0.01, 12);
+                for (int l = 0; l < n; ++l) {
+                    expected[size_t(l)] = kSamples * mix.pmf(p, l);
+                    for (int k = 0; k < 4; ++k) eq[size_t(4 * l + k)] = expected[size_t(l)] / 4.0;
+                }
+                const chi2::Result r = chi2::testCounts(observed, expected, 0.01, 24);
                 EXPECT_TRUE(r.passed) << "share " << share << " p-value " << r.pValue;
+                const chi2::Result rq = chi2::testCounts(quarters, eq, 0.01, 24);
+                EXPECT_TRUE(rq.passed) << "remapped u, share " << share << " p-value " << rq.pValue;
             }
         }
     }
