@@ -274,12 +274,11 @@ glm::vec3 HemiField::sample(int region, glm::vec2 u, float uPick, float* pdfOut,
     const float density = strataProbability(c, j) * layout_.density();
     // Report exactly pdf(region, w), so that MIS weights computed later agree; rounding may
     // move a direction on a stratum edge to its neighbour. Away from the edges (u, now the
-    // position in the stratum, at least
-    // kEdge inside, so that with up to 64x64 strata w is at least 1.5e-5 in cos(theta) and
-    // 9e-5 rad in phi from an edge, and at least 5e-3 from the pole: a hundred times the
-    // rounding of the frame's round trip) w's stratum is j, without finding it again. On the
-    // horizon (pdf 0) keep the drawn stratum's density: such a direction carries no
-    // cosine-weighted contribution.
+    // position in the stratum, at least kEdge inside, so that with up to 64x64 strata w is at
+    // least 1.5e-5 in cos(theta) and 9e-5 rad in phi from an edge, and at least 5e-3 from the
+    // pole: a hundred times the rounding of the frame's round trip) w's stratum is j, without
+    // finding it again. On the horizon (pdf 0) keep the drawn stratum's density: such a
+    // direction carries no cosine-weighted contribution.
     constexpr float kEdge = 1.f / 1024.f;
     if (u.x >= kEdge && u.x <= 1.f - kEdge && u.y >= kEdge && u.y <= 1.f - kEdge) {
         if (bin) *bin = j;
