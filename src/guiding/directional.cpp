@@ -64,46 +64,44 @@ void buildStrataCdf(const double* q, int n, double epsilon, float* cdf) {
     cdf[n] = 1.f;
 }
 
-int sampleStrataCdf(const float* cdf, int n, float u) {
-    // First entry of cdf[1..n] strictly greater than u; zero-width strata are skipped.
-    const float* it = std::upper_bound(cdf + 1, cdf + n + 1, u);
-    int j = static_cast<int>(it - (cdf + 1));
-    if (j < n) return j;
-    j = n - 1;  // u >= 1 (outside the contract): the last stratum of non-zero probability
-    while (j > 0 && !(cdf[j + 1] > cdf[j])) --j;
-    return j;
+namespace {
+
+// The piece of a CDF holding u: pieces i = 0..n-1 span [cdf[i * stride], cdf[(i + 1) * stride]);
+// the first whose end exceeds u, so pieces of zero width are skipped. If none does (u at or
+// above the last end: u >= 1, or a rounded position inside a row), the last piece of
+// non-zero width.
+int pieceAbove(const float* cdf, int n, int stride, float u) {
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (cdf[(mid + 1) * stride] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    // (A piece found by its end has start <= u < end: the loop only steps back from a last
+    // piece not found.)
+    while (lo > 0 && !(cdf[(lo + 1) * stride] > cdf[lo * stride])) --lo;
+    return lo;
 }
 
+// u's place in the piece [lo, hi), in [0,1) (0 for a piece of zero width).
+float placeIn(float u, float lo, float hi) {
+    const float w = hi - lo;
+    return w > 0.f ? std::clamp((u - lo) / w, 0.f, 0.99999994f) : 0.f;
+}
+
+}  // namespace
+
+int sampleStrataCdf(const float* cdf, int n, float u) { return pieceAbove(cdf, n, 1, u); }
+
 int sampleStrataCdf2D(const float* cdf, int cols, int rows, glm::vec2 u, glm::vec2* cell) {
-    // The row: the first whose end exceeds u.x (rows of zero probability are skipped).
-    int lo = 0, hi = rows - 1;
-    while (lo < hi) {
-        const int mid = (lo + hi) / 2;
-        if (cdf[(mid + 1) * cols] > u.x) hi = mid;
-        else lo = mid + 1;
-    }
-    int row = lo;
-    // u.x at or above the last row's end (only by rounding): the last row of non-zero
-    // probability.
-    while (row > 0 && !(cdf[(row + 1) * cols] > cdf[row * cols])) --row;
+    // The row by the rows' marginal (a row's share is its end minus its start in the CDF).
+    const int row = pieceAbove(cdf, rows, cols, u.x);
     const float* c = cdf + row * cols;
-    const float r0 = c[0], pr = c[cols] - c[0];
-    const float fx = pr > 0.f ? (u.x - r0) / pr : 0.f;
-    // The column: within the row's share of the CDF, at the fraction u.y of it.
-    const float t = r0 + u.y * pr;
-    lo = 0;
-    hi = cols - 1;
-    while (lo < hi) {
-        const int mid = (lo + hi) / 2;
-        if (c[mid + 1] > t) hi = mid;
-        else lo = mid + 1;
-    }
-    int col = lo;
-    while (col > 0 && !(c[col + 1] > c[col])) --col;
-    const float pc = c[col + 1] - c[col];
-    const float fy = pc > 0.f ? (t - c[col]) / pc : 0.f;
-    cell->x = std::clamp(fx, 0.f, 0.99999994f);
-    cell->y = std::clamp(fy, 0.f, 0.99999994f);
+    // The column within the row's share of the CDF, at the fraction u.y of it.
+    const float t = c[0] + u.y * (c[cols] - c[0]);
+    const int col = pieceAbove(c, cols, 1, t);
+    cell->x = placeIn(u.x, c[0], c[cols]);
+    cell->y = placeIn(t, c[col], c[col + 1]);
     return row * cols + col;
 }
 

@@ -58,11 +58,7 @@ float Distribution1D::sampleContinuous(float u, float* pdf, int* offset) const {
 int Distribution1D::sampleDiscrete(float u, float* pmf, float* uRemapped) const {
     int i = findInterval(u);
     if (pmf) *pmf = discretePmf(i);
-    if (uRemapped) {
-        float width = cdf_[i + 1] - cdf_[i];
-        float r = width > 0.f ? (u - cdf_[i]) / width : 0.f;
-        *uRemapped = clamp(r, 0.f, OneMinusEpsilon);
-    }
+    if (uRemapped) *uRemapped = remapInInterval(u, cdf_[i], cdf_[i + 1]);
     return i;
 }
 

@@ -13,12 +13,6 @@ LightSampler::~LightSampler() = default;
 
 namespace {
 
-// u's place in [lo, hi), rescaled to [0,1).
-float remapped(float u, float lo, float hi) {
-    const float w = hi - lo;
-    return w > 0.f ? clamp((u - lo) / w, 0.f, OneMinusEpsilon) : 0.f;
-}
-
 // Radical inverse of i in the baseIndex-th prime (Halton points inside a voxel).
 float haltonCoordinate(int baseIndex, uint32_t i) {
     static const uint32_t primes[] = {2, 3, 5, 7, 11};
@@ -160,7 +154,7 @@ int SpatialLightSampler::sample(const Vec3& p, float u, float* pmf, float* uRema
     i = clamp(i, 0, n - 1);
     while (i > 0 && cdf[n + 1 + i] == 0.f) --i;
     *pmf = cdf[n + 1 + i];
-    if (uRemapped) *uRemapped = remapped(u, cdf[i], cdf[i + 1]);
+    if (uRemapped) *uRemapped = remapInInterval(u, cdf[i], cdf[i + 1]);
     return i;
 }
 
@@ -205,7 +199,8 @@ int LightGroups::sample(int g, float u, float* uRemapped) const {
     const int b = first_[size_t(g)], e = first_[size_t(g) + 1];
     const auto it = std::upper_bound(cdf_.begin() + b, cdf_.begin() + e, u);
     const int k = std::min(int(it - cdf_.begin()), e - 1);
-    if (uRemapped) *uRemapped = remapped(u, k > b ? cdf_[size_t(k) - 1] : 0.f, cdf_[size_t(k)]);
+    if (uRemapped)
+        *uRemapped = remapInInterval(u, k > b ? cdf_[size_t(k) - 1] : 0.f, cdf_[size_t(k)]);
     return members_[size_t(k)];
 }
 
@@ -216,7 +211,7 @@ int MixedLightChoice::sample(const Vec3& p, float u, float* pmfOut, float* uRema
     if (u < share) {
         const float v = std::min(u / share, OneMinusEpsilon);
         const int g = guiding::sampleStrataCdf(cdf, groups.count(), v);
-        light = groups.sample(g, remapped(v, cdf[g], cdf[g + 1]), uRemapped);
+        light = groups.sample(g, remapInInterval(v, cdf[g], cdf[g + 1]), uRemapped);
     } else {
         light = base.sample(p, std::min((u - share) / (1.f - share), OneMinusEpsilon), &known,
                             uRemapped);

@@ -36,7 +36,7 @@ public:
             acc += this->pmf(p, i);
             if (u < acc || i == n_ - 1) {
                 *pmf = this->pmf(p, i);
-                if (uRemapped) *uRemapped = std::clamp((u - lo) / *pmf, 0.f, OneMinusEpsilon);
+                if (uRemapped) *uRemapped = remapInInterval(u, lo, acc);
                 return i;
             }
         }
