@@ -212,4 +212,23 @@ inline uint32_t permutationElement(uint32_t i, uint32_t n, uint64_t seed) {
     return (i + p) % n;
 }
 
+// Element i of a permutation of [0, n), n a power of two, chosen by seed, that keeps prefixes
+// stratified: the runs of 16 indices are shuffled by a nested uniform (Owen) scramble of
+// their numbers (bit j flipped by a seed-dependent function of the bits above it, so every
+// aligned block of 2^k runs maps onto an aligned block of runs), the indices within a run by
+// permutationElement seeded per run. A prefix of 16 2^k indices, and any aligned block of
+// that size, is then an aligned block of the unshuffled sequence: for the Sobol'
+// (0,2)-sequence a net, so a render that stops inside a block of samples keeps the
+// stratification of what it took (Burley 2020, "Practical Hash-based Owen Scrambling",
+// section 4, shuffles by a nested scramble alone; pbrt-v4's ZSobolSampler permutes base-4
+// digits alike). Within a run a random permutation, as for n <= 16 (where this is
+// permutationElement): a nested scramble there pairs two dimensions' values alike level by
+// level (the correlation of two dimensions over a pixel's 64 samples had 1.6 times the
+// variance of a random pairing's) and cost 1.5-2% more error per sample at 16 spp.
+inline uint32_t progressivePermutationElement(uint32_t i, uint32_t n, uint64_t seed) {
+    if (n <= 16) return permutationElement(i, n, seed);
+    const uint32_t run = owenScramble(i >> 4, seed) & ((n >> 4) - 1);
+    return run << 4 | permutationElement(i & 15u, 16, mixBits(seed + (run + 1) * GoldenGamma));
+}
+
 }  // namespace rlpbrt

@@ -113,9 +113,15 @@ void PaddedSobolSampler::startPixelSample(int px, int py, int sampleIndex, int d
     dim_ = uint32_t(dim);
 }
 
+uint32_t PaddedSobolSampler::shuffled(uint64_t h) const {
+    const uint32_t n = uint32_t(spp_);
+    return (n & (n - 1)) == 0 ? progressivePermutationElement(index_, n, h ^ blockSeed_)
+                              : permutationElement(index_, n, h ^ blockSeed_);
+}
+
 float PaddedSobolSampler::get1D() {
     const uint64_t h = dimHash(key_, dim_++);
-    const uint32_t i = base_ + permutationElement(index_, uint32_t(spp_), h ^ blockSeed_);
+    const uint32_t i = base_ + shuffled(h);
     // owenScramble(sobolDim0(i)) without the two bit reversals that cancel.
     return bitsToUnitFloat(reverseBits32(ascendingHash(i, scrambleSeedX(h))));
 }
@@ -123,7 +129,7 @@ float PaddedSobolSampler::get1D() {
 Vec2 PaddedSobolSampler::get2D() {
     const uint64_t h = dimHash(key_, dim_);
     dim_ += 2;
-    const uint32_t i = base_ + permutationElement(index_, uint32_t(spp_), h ^ blockSeed_);
+    const uint32_t i = base_ + shuffled(h);
     const uint32_t x = reverseBits32(ascendingHash(i, scrambleSeedX(h)));
     // owenScramble(sobolDim1(i)), again without the reversals that cancel.
     const uint32_t y = reverseBits32(ascendingHash(sobolDim1Reversed(i), scrambleSeedY(h)));

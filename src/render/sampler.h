@@ -95,6 +95,10 @@ private:
 // sequence). For power-of-two spp each 2D pair of a pixel's spp samples is a (0,m,2)-net and
 // each 1D dimension has one sample per 1/spp interval; other spp take the first spp points
 // of the (0,2)-sequence. Serves "sobol", "02sequence", "maxmindist" and "halton".
+// For power-of-two spp above 16 the shuffle keeps prefixes stratified
+// (progressivePermutationElement): the first 16 2^k samples of a block are a (0,k+4,2)-net
+// too, so a `--time` render that stops inside a block of the scene's pixelsamples keeps the
+// stratification of what it took.
 class PaddedSobolSampler final : public Sampler {
 public:
     // spp >= 1; pixelCenter makes getPixel2D return (0.5, 0.5) (halton "samplepixelcenter").
@@ -108,6 +112,8 @@ public:
     std::unique_ptr<Sampler> passSampler(int setSize, int pass) const override;
 
 private:
+    // The block's index of this sample in dimension hash h (index_ shuffled).
+    uint32_t shuffled(uint64_t h) const;
     uint64_t seed_;
     bool pixelCenter_;
     uint64_t key_ = 0;      // hash of (seed, pixel)

@@ -119,6 +119,41 @@ TEST(LowDiscrepancy, SmallPermutationsCoverTheSymmetricGroup) {
     }
 }
 
+// The progressive permutation of a block's indices: a permutation that maps every aligned
+// block of 16 2^k indices onto an aligned block of the same size (permutationElement itself
+// for n <= 16), with element positions uniform over seeds (chi-square as
+// PermutationPositionsAreUniform).
+TEST(LowDiscrepancy, ProgressivePermutationKeepsAlignedBlocks) {
+    for (uint32_t n : {2u, 16u, 32u, 64u, 1024u}) {
+        for (uint64_t seed : {1ull, 99ull, 0xdeadbeefull}) {
+            std::vector<int> seen(n, 0);
+            for (uint32_t i = 0; i < n; ++i) {
+                const uint32_t p = progressivePermutationElement(i, n, seed);
+                ASSERT_LT(p, n);
+                ++seen[p];
+                if (n <= 16) {
+                    EXPECT_EQ(p, permutationElement(i, n, seed));
+                }
+                for (uint32_t k = 16; k < n; k <<= 1)  // i's aligned block of size k ...
+                    ASSERT_EQ(p / k, progressivePermutationElement(i - i % k, n, seed) / k)
+                        << "n=" << n << " k=" << k;  // ... maps into one block of size k
+            }
+            for (uint32_t j = 0; j < n; ++j) EXPECT_EQ(seen[j], 1) << "n=" << n;
+        }
+    }
+    const int S = 20000;
+    for (uint32_t n : {32u, 64u}) {
+        std::vector<double> count(n * n, 0);
+        for (int s = 0; s < S; ++s)
+            for (uint32_t i = 0; i < n; ++i)
+                ++count[i * n + progressivePermutationElement(i, n, mixBits(s + 12345))];
+        double chi2 = 0, e = double(S) / n;
+        for (double c : count) chi2 += (c - e) * (c - e) / e;
+        const double dof = (n - 1.0) * (n - 1.0);
+        EXPECT_LT(chi2, dof + 5 * std::sqrt(2 * dof)) << "n=" << n;
+    }
+}
+
 TEST(LowDiscrepancy, OwenScramblePreservesStrata) {
     // An Owen scramble maps each dyadic interval onto a dyadic interval of the same level:
     // values sharing their top k bits still share them afterwards.
@@ -328,6 +363,37 @@ TEST(Sampler, SobolFamilyPointSetsAreZeroMTwoNets) {
                     std::vector<int> c1(n, 0);
                     for (float v : pts1) ++c1[int(v * n)];
                     for (int c : c1) ASSERT_EQ(c, 1) << name << " n=" << n << " dim=" << dim;
+                }
+            }
+        }
+    }
+}
+
+// A --time render that stops inside a block of the scene's pixelsamples takes its first
+// samples: every prefix of 16 2^k samples of a block, and every aligned part of one that
+// size, is a (0,k+4,2)-net in each 2D pair and stratified in each 1D dimension.
+TEST(Sampler, SobolFamilyBlockPrefixesAreNets) {
+    for (const char* name : {"sobol", "02sequence"}) {
+        auto s = make(name, 256, 11);
+        for (int dim : {0, 2, 7, 300}) {
+            for (int first : {0, 16, 32, 64, 256 + 128}) {  // (the last in the second block)
+                for (int m : {4, 6}) {
+                    if (first % (1 << m) != 0) continue;  // (aligned parts only)
+                    std::vector<Vec2> pts2;
+                    std::vector<float> pts1;
+                    for (int i = first; i < first + (1 << m); ++i) {
+                        s->startPixelSample(3, 8, i, dim);
+                        pts2.push_back(dim == 0 ? s->getPixel2D() : s->get2D());
+                        s->startPixelSample(3, 8, i, dim);
+                        pts1.push_back(s->get1D());
+                    }
+                    for (int a = 0; a <= m; ++a)
+                        for (int c : cellCounts(pts2, a, m - a))
+                            ASSERT_EQ(c, 1) << name << " dim=" << dim << " first=" << first
+                                            << " m=" << m << " a=" << a;
+                    std::vector<int> c1(size_t(1) << m, 0);
+                    for (float v : pts1) ++c1[size_t(v * float(1 << m))];
+                    for (int c : c1) ASSERT_EQ(c, 1) << name << " dim=" << dim;
                 }
             }
         }
