@@ -74,20 +74,22 @@ TEST(LowDiscrepancy, PermutationElementIsAPermutation) {
     }
 }
 
-TEST(LowDiscrepancy, PermutationPositionsAreUniform) {
-    // Over S seeds, count[i][j] = #(perm(i) == j) ~ Binomial(S, 1/n); chi-square with
-    // (n-1)^2 dof has mean dof and sd sqrt(2 dof): bound mean + 5 sd.
+// Over S seeds, count[i][j] = #(perm(i, n, seed) == j) ~ Binomial(S, 1/n); chi-square with
+// (n-1)^2 dof has mean dof and sd sqrt(2 dof): bound mean + 5 sd.
+template <class Permutation>
+void expectUniformPositions(Permutation perm, uint32_t n) {
     const int S = 20000;
-    for (uint32_t n : {3u, 5u, 9u, 12u, 16u}) {
-        std::vector<double> count(n * n, 0);
-        for (int s = 0; s < S; ++s)
-            for (uint32_t i = 0; i < n; ++i)
-                ++count[i * n + permutationElement(i, n, mixBits(s + 12345))];
-        double chi2 = 0, e = double(S) / n;
-        for (double c : count) chi2 += (c - e) * (c - e) / e;
-        const double dof = (n - 1.0) * (n - 1.0);
-        EXPECT_LT(chi2, dof + 5 * std::sqrt(2 * dof)) << "n=" << n;
-    }
+    std::vector<double> count(n * n, 0);
+    for (int s = 0; s < S; ++s)
+        for (uint32_t i = 0; i < n; ++i) ++count[i * n + perm(i, n, mixBits(s + 12345))];
+    double chi2 = 0, e = double(S) / n;
+    for (double c : count) chi2 += (c - e) * (c - e) / e;
+    const double dof = (n - 1.0) * (n - 1.0);
+    EXPECT_LT(chi2, dof + 5 * std::sqrt(2 * dof)) << "n=" << n;
+}
+
+TEST(LowDiscrepancy, PermutationPositionsAreUniform) {
+    for (uint32_t n : {3u, 5u, 9u, 12u, 16u}) expectUniformPositions(permutationElement, n);
 }
 
 // The permutations of small n are drawn from (nearly) all of them, uniformly: Kensler's hash
@@ -121,8 +123,7 @@ TEST(LowDiscrepancy, SmallPermutationsCoverTheSymmetricGroup) {
 
 // The progressive permutation of a block's indices: a permutation that maps every aligned
 // block of 16 2^k indices onto an aligned block of the same size (permutationElement itself
-// for n <= 16), with element positions uniform over seeds (chi-square as
-// PermutationPositionsAreUniform).
+// for n <= 16), with element positions uniform over seeds.
 TEST(LowDiscrepancy, ProgressivePermutationKeepsAlignedBlocks) {
     for (uint32_t n : {2u, 16u, 32u, 64u, 1024u}) {
         for (uint64_t seed : {1ull, 99ull, 0xdeadbeefull}) {
@@ -141,17 +142,7 @@ TEST(LowDiscrepancy, ProgressivePermutationKeepsAlignedBlocks) {
             for (uint32_t j = 0; j < n; ++j) EXPECT_EQ(seen[j], 1) << "n=" << n;
         }
     }
-    const int S = 20000;
-    for (uint32_t n : {32u, 64u}) {
-        std::vector<double> count(n * n, 0);
-        for (int s = 0; s < S; ++s)
-            for (uint32_t i = 0; i < n; ++i)
-                ++count[i * n + progressivePermutationElement(i, n, mixBits(s + 12345))];
-        double chi2 = 0, e = double(S) / n;
-        for (double c : count) chi2 += (c - e) * (c - e) / e;
-        const double dof = (n - 1.0) * (n - 1.0);
-        EXPECT_LT(chi2, dof + 5 * std::sqrt(2 * dof)) << "n=" << n;
-    }
+    for (uint32_t n : {32u, 64u}) expectUniformPositions(progressivePermutationElement, n);
 }
 
 TEST(LowDiscrepancy, OwenScramblePreservesStrata) {
