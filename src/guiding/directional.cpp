@@ -83,12 +83,6 @@ int pieceAbove(const float* cdf, int n, int stride, float u) {
     return lo;
 }
 
-// u's place in the piece [lo, hi), in [0,1) (0 for a piece of zero width).
-float placeIn(float u, float lo, float hi) {
-    const float w = hi - lo;
-    return w > 0.f ? std::clamp((u - lo) / w, 0.f, 0.99999994f) : 0.f;
-}
-
 }  // namespace
 
 int sampleStrataCdf(const float* cdf, int n, float u) { return pieceAbove(cdf, n, 1, u); }
@@ -100,8 +94,8 @@ int sampleStrataCdf2D(const float* cdf, int cols, int rows, glm::vec2 u, glm::ve
     // The column within the row's share of the CDF, at the fraction u.y of it.
     const float t = c[0] + u.y * (c[cols] - c[0]);
     const int col = pieceAbove(c, cols, 1, t);
-    cell->x = placeIn(u.x, c[0], c[cols]);
-    cell->y = placeIn(t, c[col], c[col + 1]);
+    cell->x = remapInInterval(u.x, c[0], c[cols]);
+    cell->y = remapInInterval(t, c[col], c[col + 1]);
     return row * cols + col;
 }
 

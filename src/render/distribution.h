@@ -8,14 +8,6 @@
 
 namespace rlpbrt {
 
-// u's place in [lo, hi), rescaled to [0,1) (0 for an empty interval): the fresh uniform value
-// left over after u chose the piece [lo, hi) of a CDF (pbrt-v3's remapping of a one-sample
-// choice, which keeps a stratified u stratified for what it samples next).
-inline float remapInInterval(float u, float lo, float hi) {
-    const float w = hi - lo;
-    return w > 0.f ? clamp((u - lo) / w, 0.f, OneMinusEpsilon) : 0.f;
-}
-
 // Piecewise-constant density over [0,1] proportional to n non-negative function values.
 // Negative or non-finite values are treated as 0. If every value is 0 the distribution falls
 // back to uniform sampling (integral() still reports 0).

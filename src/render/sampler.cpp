@@ -115,8 +115,8 @@ void PaddedSobolSampler::startPixelSample(int px, int py, int sampleIndex, int d
 
 uint32_t PaddedSobolSampler::shuffled(uint64_t h) const {
     const uint32_t n = uint32_t(spp_);
-    return (n & (n - 1)) == 0 ? progressivePermutationElement(index_, n, h ^ blockSeed_)
-                              : permutationElement(index_, n, h ^ blockSeed_);
+    return powerOfTwo_ ? progressivePermutationElement(index_, n, h ^ blockSeed_)
+                       : permutationElement(index_, n, h ^ blockSeed_);
 }
 
 float PaddedSobolSampler::get1D() {

@@ -103,7 +103,10 @@ class PaddedSobolSampler final : public Sampler {
 public:
     // spp >= 1; pixelCenter makes getPixel2D return (0.5, 0.5) (halton "samplepixelcenter").
     PaddedSobolSampler(int spp, uint64_t seed, bool pixelCenter = false)
-        : Sampler(spp), seed_(seed), pixelCenter_(pixelCenter) {}
+        : Sampler(spp),
+          seed_(seed),
+          pixelCenter_(pixelCenter),
+          powerOfTwo_(spp > 0 && (spp & (spp - 1)) == 0) {}
     void startPixelSample(int px, int py, int sampleIndex, int dim = 0) override;
     float get1D() override;
     Vec2 get2D() override;
@@ -116,6 +119,7 @@ private:
     uint32_t shuffled(uint64_t h) const;
     uint64_t seed_;
     bool pixelCenter_;
+    bool powerOfTwo_;       // spp is a power of two: blocks shuffled progressively
     uint64_t key_ = 0;      // hash of (seed, pixel)
     uint32_t base_ = 0;     // (sampleIndex / spp) * spp: first Sobol' index of the block
     uint32_t index_ = 0;    // sampleIndex % spp

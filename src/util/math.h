@@ -22,6 +22,16 @@ constexpr float Infinity = std::numeric_limits<float>::infinity();
 // Largest float below one: upper bound for sample values in [0,1).
 constexpr float OneMinusEpsilon = 0x1.fffffep-1f;
 
+// u's place in [lo, hi), rescaled to [0,1) (0 for an empty interval): the fresh uniform value
+// left over after u chose the piece [lo, hi) of a CDF (pbrt-v3's remapping of a one-sample
+// choice, which keeps a stratified u stratified for what it samples next).
+inline float remapInInterval(float u, float lo, float hi) {
+    const float w = hi - lo;
+    if (!(w > 0.f)) return 0.f;
+    const float t = (u - lo) / w;
+    return t < 0.f ? 0.f : (t < OneMinusEpsilon ? t : OneMinusEpsilon);
+}
+
 // Orthonormal basis around a unit normal n (Duff et al. 2017, "Building an Orthonormal
 // Basis, Revisited"). Local coordinates have z along n.
 struct Frame {
