@@ -1,6 +1,6 @@
 // Basics that every layer may use (src/util: the standard library and GLM only): constants,
-// the remapping of a one-sample choice's u, an orthonormal frame. The render layer adds its types in render/math.h; the guiding layer
-// uses these directly.
+// the remapping of a one-sample choice's u, an orthonormal frame. The render layer adds its
+// types in render/math.h; the guiding layer uses these directly.
 #pragma once
 
 #include <cmath>
