@@ -325,6 +325,7 @@ bool intersect(const Quadric& q, const Vec3& oF, const Vec3& dF, float tMinF, fl
     for (int i = 0; i < (t0 == t1 ? 1 : 2); ++i) {
         double t = ts[i];
         if (!(t > tMin && t < tMax)) continue;
+        if (!hit && isFullSphere(q)) return true;  // nothing clipped: no parametrisation
         DHit h;
         if (!surfacePoint(q, o + t * d, &h)) continue;
         if (hit) fillHit(h, t, hit);

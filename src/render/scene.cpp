@@ -85,8 +85,7 @@ void quadricOccluded(const RTCOccludedFunctionNArguments* args) {
     auto* ray = reinterpret_cast<RTCRay*>(args->ray);
     Vec3 o(ray->org_x, ray->org_y, ray->org_z);
     Vec3 d(ray->dir_x, ray->dir_y, ray->dir_z);
-    QuadricHit hit;
-    if (quadricHit(q, o, d, ray->tnear, ray->tfar, &hit)) ray->tfar = -Infinity;
+    if (quadricHit(q, o, d, ray->tnear, ray->tfar, nullptr)) ray->tfar = -Infinity;
 }
 
 // ------------------------------------------------------------------------------------------
