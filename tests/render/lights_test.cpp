@@ -462,6 +462,32 @@ struct EnvFixture : Fixture {
     }
 };
 
+// The integral of the light's pdfLi over the sphere by the midpoint rule on a 300 x 600 grid
+// in (theta, phi), not aligned with the sampling table's cells.
+double pdfIntegral(const EnvFixture& e) {
+    const int nT = 300, nP = 600;
+    double sum = 0;
+    LightSampleContext ctx;
+    for (int it = 0; it < nT; ++it)
+        for (int ip = 0; ip < nP; ++ip) {
+            float theta = (it + 0.5f) / nT * Pi, phi = (ip + 0.5f) / nP * 2.f * Pi;
+            float pdf = e.light->pdfLi(ctx, e.worldDir(theta, phi), Vec3(0.f), Vec3(0.f));
+            sum += pdf * std::sin(theta) * (Pi / nT) * (2.0 * Pi / nP);
+        }
+    return sum;
+}
+
+// The map's integral over the sphere (red channel): texel values times their solid angles,
+// 2 pi / W (cos theta0 - cos theta1).
+double texelIntegral(const EnvFixture& e) {
+    double sum = 0;
+    for (int y = 0; y < e.kH; ++y)
+        for (int x = 0; x < e.kW; ++x)
+            sum += e.rgb[(size_t(y) * e.kW + x) * 3] * 2.0 * Pi / e.kW *
+                   (std::cos(Pi * y / e.kH) - std::cos(Pi * (y + 1) / e.kH));
+    return sum;
+}
+
 TEST(Lights, InfiniteLightLeAtTexelCentres) {
     EnvFixture e;
     ASSERT_NE(e.light, nullptr);
@@ -477,14 +503,13 @@ TEST(Lights, InfiniteLightLeAtTexelCentres) {
         }
 }
 
-TEST(Lights, InfiniteLightSamplePdfMatchesPdfLiAndLe) {
-    EnvFixture e;
-    ASSERT_NE(e.light, nullptr);
+// Samples of e's light carry the density pdfLi gives their direction and the radiance Le
+// gives it. A direction sampled next to an edge of a distribution cell can round into the
+// neighbouring cell when mapped back: a few such samples are allowed, not more.
+void expectSamplesMatchPdfLiAndLe(const EnvFixture& e, uint64_t seed) {
     LightSampleContext ctx;
     ctx.p = Vec3(3, -1, 2);
-    Rng rng(11);
-    // A direction sampled next to an edge of a distribution cell can round into the
-    // neighbouring cell when mapped back: allow a few such samples, not more.
+    Rng rng(seed);
     int n = 20000, valid = 0, pdfMismatch = 0, leMismatch = 0;
     for (int i = 0; i < n; ++i) {
         LightSample s;
@@ -502,22 +527,18 @@ TEST(Lights, InfiniteLightSamplePdfMatchesPdfLiAndLe) {
     EXPECT_LE(leMismatch, n / 500);
 }
 
+TEST(Lights, InfiniteLightSamplePdfMatchesPdfLiAndLe) {
+    EnvFixture e;
+    ASSERT_NE(e.light, nullptr);
+    expectSamplesMatchPdfLiAndLe(e, 11);
+}
+
 TEST(Lights, InfiniteLightPdfIntegratesToOne) {
     EnvFixture e;
     ASSERT_NE(e.light, nullptr);
-    // Midpoint rule over a grid not aligned with the 32x16 distribution; the pdf is piecewise
-    // constant in (phi, theta) after the sin(theta) factor, so the error is only from the
-    // cells cut by grid lines: well below 1%.
-    const int nT = 300, nP = 600;
-    double sum = 0;
-    LightSampleContext ctx;
-    for (int it = 0; it < nT; ++it)
-        for (int ip = 0; ip < nP; ++ip) {
-            float theta = (it + 0.5f) / nT * Pi, phi = (ip + 0.5f) / nP * 2.f * Pi;
-            float pdf = e.light->pdfLi(ctx, e.worldDir(theta, phi), Vec3(0.f), Vec3(0.f));
-            sum += pdf * std::sin(theta) * (Pi / nT) * (2.0 * Pi / nP);
-        }
-    EXPECT_NEAR(sum, 1.0, 5e-3);
+    // The pdf is piecewise constant in (phi, theta) after the sin(theta) factor, so the
+    // midpoint rule's error is only from the 32x16 cells cut by its grid lines: well below 1%.
+    EXPECT_NEAR(pdfIntegral(e), 1.0, 5e-3);
 }
 
 TEST(Lights, InfiniteLightSamplingChiSquare) {
@@ -550,34 +571,12 @@ TEST(Lights, InfiniteLightSamplingChiSquare) {
 TEST(Lights, InfiniteLightLargeMapSampledAtItsResolution) {
     EnvFixture e(1024, 512);
     ASSERT_NE(e.light, nullptr);
+    expectSamplesMatchPdfLiAndLe(e, 12);
     LightSampleContext ctx;
-    Rng rng(12);
-    int n = 20000, valid = 0, pdfMismatch = 0;
-    for (int i = 0; i < n; ++i) {
-        LightSample s;
-        if (!e.light->sampleLi(ctx, rng.uniform2(), &s)) continue;
-        ++valid;
-        float pdf = e.light->pdfLi(ctx, s.wi, Vec3(0.f), Vec3(0.f));
-        if (std::abs(pdf - s.pdf) > 2e-3f * s.pdf) ++pdfMismatch;
-    }
-    EXPECT_GT(valid, n * 99 / 100);
-    EXPECT_LE(pdfMismatch, n / 500);
-    const int nT = 300, nP = 600;
-    double sum = 0;
-    for (int it = 0; it < nT; ++it)
-        for (int ip = 0; ip < nP; ++ip) {
-            float theta = (it + 0.5f) / nT * Pi, phi = (ip + 0.5f) / nP * 2.f * Pi;
-            float pdf = e.light->pdfLi(ctx, e.worldDir(theta, phi), Vec3(0.f), Vec3(0.f));
-            sum += pdf * std::sin(theta) * (Pi / nT) * (2.0 * Pi / nP);
-        }
-    EXPECT_NEAR(sum, 1.0, 5e-3);
-    // The map's integral: its texels times their solid angles (bilinear filtering moves
-    // almost nothing at this resolution); 5 standard errors plus that 0.5%.
-    double texelSum = 0;
-    for (int y = 0; y < e.kH; ++y)
-        for (int x = 0; x < e.kW; ++x)
-            texelSum += e.rgb[(size_t(y) * e.kW + x) * 3] * 2.0 * Pi / e.kW *
-                        (std::cos(Pi * y / e.kH) - std::cos(Pi * (y + 1) / e.kH));
+    EXPECT_NEAR(pdfIntegral(e), 1.0, 5e-3);
+    // The map's integral from its texels (bilinear filtering moves almost nothing at this
+    // resolution); 5 standard errors plus 0.5%.
+    const double texelSum = texelIntegral(e);
     Rng rng2(13), rng3(14);
     const int m = 100000;
     Estimate est = monteCarlo(m, [&](int) {
@@ -604,14 +603,8 @@ TEST(Lights, InfiniteLightImportanceSampledIntegralOfLe) {
             direct += e.light->Le(e.worldDir(theta, phi)).x * std::sin(theta) * (Pi / nT) *
                       (2.0 * Pi / nP);
         }
-    // Reference 2: texel values times their solid angles, 2pi/W (cos theta0 - cos theta1).
-    double texelSum = 0;
-    for (int y = 0; y < e.kH; ++y)
-        for (int x = 0; x < e.kW; ++x) {
-            double dOmega = 2.0 * Pi / e.kW *
-                            (std::cos(Pi * y / e.kH) - std::cos(Pi * (y + 1) / e.kH));
-            texelSum += e.rgb[(size_t(y) * e.kW + x) * 3] * dOmega;
-        }
+    // Reference 2: texel values times their solid angles.
+    const double texelSum = texelIntegral(e);
     // Bilinear filtering (with pbrt-v3's repeat wrap across the poles) redistributes energy
     // between neighbouring texels; for this map the two references agree to a few percent.
     EXPECT_NEAR(direct, texelSum, 0.03 * texelSum);
