@@ -488,6 +488,24 @@ double texelIntegral(const EnvFixture& e) {
     return sum;
 }
 
+// Monte Carlo estimates of the map's integral (red channel) from n directions: sampled by the
+// light (Le / pdf), and uniform over the sphere.
+Estimate sampledIntegral(const EnvFixture& e, uint64_t seed, int n) {
+    LightSampleContext ctx;
+    Rng rng(seed);
+    return monteCarlo(n, [&](int) {
+        LightSample s;
+        if (!e.light->sampleLi(ctx, rng.uniform2(), &s)) return 0.0;
+        return double(s.L.x) / s.pdf;
+    });
+}
+Estimate uniformIntegral(const EnvFixture& e, uint64_t seed, int n) {
+    Rng rng(seed);
+    return monteCarlo(n, [&](int) {
+        return double(e.light->Le(sampleUniformSphere(rng.uniform2())).x) / uniformSpherePdf();
+    });
+}
+
 TEST(Lights, InfiniteLightLeAtTexelCentres) {
     EnvFixture e;
     ASSERT_NE(e.light, nullptr);
@@ -572,22 +590,13 @@ TEST(Lights, InfiniteLightLargeMapSampledAtItsResolution) {
     EnvFixture e(1024, 512);
     ASSERT_NE(e.light, nullptr);
     expectSamplesMatchPdfLiAndLe(e, 12);
-    LightSampleContext ctx;
     EXPECT_NEAR(pdfIntegral(e), 1.0, 5e-3);
     // The map's integral from its texels (bilinear filtering moves almost nothing at this
     // resolution); 5 standard errors plus 0.5%.
     const double texelSum = texelIntegral(e);
-    Rng rng2(13), rng3(14);
-    const int m = 100000;
-    Estimate est = monteCarlo(m, [&](int) {
-        LightSample s;
-        if (!e.light->sampleLi(ctx, rng2.uniform2(), &s)) return 0.0;
-        return double(s.L.x) / s.pdf;
-    });
+    const Estimate est = sampledIntegral(e, 13, 100000);
     EXPECT_NEAR(est.mean, texelSum, 5.0 * est.stdErr + 5e-3 * texelSum);
-    Estimate uni = monteCarlo(m, [&](int) {
-        return double(e.light->Le(sampleUniformSphere(rng3.uniform2())).x) / uniformSpherePdf();
-    });
+    const Estimate uni = uniformIntegral(e, 14, 100000);
     EXPECT_LT(est.stdErr, 0.5 * uni.stdErr);
 }
 
@@ -608,21 +617,11 @@ TEST(Lights, InfiniteLightImportanceSampledIntegralOfLe) {
     // Bilinear filtering (with pbrt-v3's repeat wrap across the poles) redistributes energy
     // between neighbouring texels; for this map the two references agree to a few percent.
     EXPECT_NEAR(direct, texelSum, 0.03 * texelSum);
-    LightSampleContext ctx;
-    Rng rng(5);
-    const int n = 200000;
-    Estimate est = monteCarlo(n, [&](int) {
-        LightSample s;
-        if (!e.light->sampleLi(ctx, rng.uniform2(), &s)) return 0.0;
-        return double(s.L.x) / s.pdf;
-    });
+    const Estimate est = sampledIntegral(e, 5, 200000);
     // 5 standard errors: a false failure has probability below 1e-6.
     EXPECT_NEAR(est.mean, direct, 5.0 * est.stdErr + 1e-4 * direct);
     // Importance sampling must have a smaller standard error than uniform sphere sampling.
-    Rng rng2(6);
-    Estimate uni = monteCarlo(n, [&](int) {
-        return double(e.light->Le(sampleUniformSphere(rng2.uniform2())).x) / uniformSpherePdf();
-    });
+    const Estimate uni = uniformIntegral(e, 6, 200000);
     EXPECT_NEAR(uni.mean, direct, 5.0 * uni.stdErr + 1e-4 * direct);
     EXPECT_LT(est.stdErr, 0.5 * uni.stdErr);
     // Power: pi r^2 times the map average (the mean of the L*scale = 1 texels).
