@@ -26,14 +26,20 @@ Distribution1D::Distribution1D(const float* f, int n) {
         cdf_[i + 1] = static_cast<float>(partial / (uniform_ ? n : total));
     }
     cdf_[n] = 1.f;
+    if (n >= kBucketMin) {
+        buckets_ = n / kPiecesPerBucket;
+        bucketStart_.resize(size_t(buckets_) + 1);
+        for (int k = 0; k < buckets_; ++k)
+            bucketStart_[size_t(k)] = searchCdf(float(k) / float(buckets_), 0, n);
+        bucketStart_[size_t(buckets_)] = n;
+    }
 }
 
-int Distribution1D::findInterval(float u) const {
-    // Largest i with cdf_[i] <= u (cdf_[0] = 0), clamped to a valid piece: a branchless
-    // binary search that loads both possible next probes ahead, since the CDFs of large
-    // environment maps miss the caches.
-    const float* b = cdf_.data();
-    size_t len = cdf_.size();
+int Distribution1D::searchCdf(float u, int lo, int hi) const {
+    // A branchless binary search that loads both possible next probes ahead, since the CDFs
+    // of large environment maps miss the caches.
+    const float* b = cdf_.data() + lo;
+    size_t len = size_t(hi - lo) + 1;
     while (len > 1) {
         const size_t half = len / 2;
         __builtin_prefetch(b + half / 2);
@@ -41,7 +47,21 @@ int Distribution1D::findInterval(float u) const {
         b = b[half] <= u ? b + half : b;
         len -= half;
     }
-    return clamp(static_cast<int>(b - cdf_.data()), 0, count() - 1);
+    return static_cast<int>(b - cdf_.data());
+}
+
+int Distribution1D::findInterval(float u) const {
+    const int n = count();
+    if (!bucketStart_.empty() && u >= 0.f && u < 1.f) {
+        const int k = std::min(static_cast<int>(u * float(buckets_)), buckets_ - 1);
+        const int lo = bucketStart_[size_t(k)], hi = bucketStart_[size_t(k) + 1];
+        // The answer i, if cdf[i] <= u < cdf[i + 1] (cdf_ has n + 1 entries).
+        if (cdf_[size_t(lo)] <= u) {
+            const int i = searchCdf(u, lo, hi);
+            if (i == n || u < cdf_[size_t(i) + 1]) return std::min(i, n - 1);
+        }
+    }
+    return clamp(searchCdf(u, 0, n), 0, n - 1);
 }
 
 float Distribution1D::sampleContinuous(float u, float* pdf, int* offset) const {

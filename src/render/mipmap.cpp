@@ -84,6 +84,7 @@ std::vector<ResampleWeight> resampleWeights(int oldRes, int newRes) {
 
 // Index of an out-of-range texel under the wrap mode; -1 for black.
 int wrapIndex(int i, int n, ImageWrap wrap) {
+    if (i >= 0 && i < n) return i;  // every mode, without Repeat's division
     switch (wrap) {
     case ImageWrap::Repeat: return mod(i, n);
     case ImageWrap::Clamp: return clamp(i, 0, n - 1);
@@ -176,11 +177,19 @@ T MipMap<T>::texel(int level, int s, int t) const {
 template <typename T>
 T MipMap<T>::bilerp(int level, const Vec2& st) const {
     level = clamp(level, 0, levels() - 1);
-    float s = st.x * float(levels_[level].width) - 0.5f;
-    float t = st.y * float(levels_[level].height) - 0.5f;
+    const Level& l = levels_[level];
+    float s = st.x * float(l.width) - 0.5f;
+    float t = st.y * float(l.height) - 0.5f;
     float fs = std::floor(s), ft = std::floor(t);
     int s0 = int(fs), t0 = int(ft);
     float ds = s - fs, dt = t - ft;
+    if (s0 >= 0 && t0 >= 0 && s0 < l.width - 1 && t0 < l.height - 1) {
+        // All four texels inside the level (the usual case): no wrapping, the same sum.
+        const T* row0 = &l.texels[size_t(t0) * size_t(l.width) + size_t(s0)];
+        const T* row1 = row0 + l.width;
+        return (1 - ds) * (1 - dt) * row0[0] + (1 - ds) * dt * row1[0] +
+               ds * (1 - dt) * row0[1] + ds * dt * row1[1];
+    }
     return (1 - ds) * (1 - dt) * texel(level, s0, t0) + (1 - ds) * dt * texel(level, s0, t0 + 1) +
            ds * (1 - dt) * texel(level, s0 + 1, t0) + ds * dt * texel(level, s0 + 1, t0 + 1);
 }
@@ -195,6 +204,9 @@ T MipMap<T>::nearest(const Vec2& st) const {
 template <typename T>
 T MipMap<T>::trilinear(const Vec2& st, float width) const {
     // Level whose texel spacing matches the filter width: 2^-(levels-1-level) = width.
+    // A width of at most 1e-8 always reads level 0 (fewer than 27 levels): environment
+    // maps' radiance lookups pass 0, without the logarithm.
+    if (!(width > 1e-8f)) return bilerp(0, st);
     float level = float(levels() - 1) + std::log2(std::max(width, 1e-8f));
     if (level < 0) return bilerp(0, st);
     if (level >= float(levels() - 1)) return texel(levels() - 1, 0, 0);

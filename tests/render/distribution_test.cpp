@@ -141,6 +141,65 @@ TEST(Distribution1D, SinglePiece) {
     EXPECT_EQ(d.sampleDiscrete(0.7f), 0);
 }
 
+// Large tables search from a bucket table: the piece found must be the one the definition
+// names (the largest i with cdf[i] <= u, at most n - 1) for every u, on tables made to
+// trouble the buckets: a spike holding most of the mass, runs of zero pieces (equal CDF
+// values), pieces far below a bucket's width, an all-zero table; u at random, at the CDF's
+// own values and their neighbours, at the bucket edges k/n, and at 0 and just below 1.
+TEST(Distribution1D, LargeTablesFindThePieceTheCdfNames) {
+    std::mt19937_64 rng(17);
+    std::vector<std::vector<float>> tables;
+    for (int n : {64, 65, 100, 1000, 4097}) {
+        const size_t count = size_t(n);
+        std::vector<float> smooth(count), spike(count, 1e-6f), runs(count), steep(count);
+        for (int i = 0; i < n; ++i) {
+            smooth[size_t(i)] = 1.f + 0.5f * std::sin(0.1f * float(i));
+            runs[size_t(i)] = (i / 7) % 3 == 0 ? 0.f : uniformFloat(rng);
+            steep[size_t(i)] = std::exp(-0.05f * float(i));
+        }
+        spike[size_t(n / 3)] = 1e6f;
+        spike[size_t(n / 3) + 1] = 3e5f;
+        tables.push_back(smooth);
+        tables.push_back(spike);
+        tables.push_back(runs);
+        tables.push_back(steep);
+        tables.push_back(std::vector<float>(count, 0.f));
+    }
+    for (const std::vector<float>& f : tables) {
+        const Distribution1D d(f);
+        const std::vector<float>& cdf = d.cdf();
+        const int n = d.count();
+        ASSERT_EQ(cdf.size(), size_t(n) + 1);
+        auto expected = [&](float u) {
+            int i = 0;
+            for (int j = 0; j <= n; ++j)
+                if (cdf[size_t(j)] <= u) i = j;
+            return std::min(i, n - 1);
+        };
+        std::vector<float> us = {0.f, OneMinusEpsilon};
+        for (int k = 0; k < 2000; ++k) us.push_back(uniformFloat(rng));
+        for (float c : cdf) {
+            us.push_back(c);
+            us.push_back(std::nextafter(c, 0.f));
+            us.push_back(std::nextafter(c, 1.f));
+        }
+        for (int k = 0; k <= n; ++k) {
+            const float edge = float(k) / float(n);
+            us.push_back(edge);
+            us.push_back(std::nextafter(edge, 0.f));
+            us.push_back(std::nextafter(edge, 1.f));
+        }
+        for (float u : us) {
+            if (!(u >= 0.f && u < 1.f)) continue;
+            float pmf = 0.f;
+            ASSERT_EQ(d.sampleDiscrete(u, &pmf), expected(u)) << "n " << n << " u " << u;
+            int offset = -1;
+            d.sampleContinuous(u, nullptr, &offset);
+            ASSERT_EQ(offset, expected(u));
+        }
+    }
+}
+
 // 6 x 4 grid with a zero row and zero cells.
 std::vector<float> gridFunction() {
     return {1.f, 2.f, 0.f, 4.f, 1.f, 1.f,   //
