@@ -194,6 +194,16 @@ float diffuseShare(const BSDF::LobeCounts& lobes) {
 // not counted as smooth).
 bool guidable(const BSDF::LobeCounts& lobes) { return lobes.all > 0 && lobes.smooth == lobes.all; }
 
+// a + t wrapped into [0, 1) (a in [0, 1), t in [0, 1)): a uniform a stays uniform.
+float shiftUnit(float a, float t) {
+    const float v = a + t;
+    return std::min(v < 1.f ? v : v - 1.f, OneMinusEpsilon);
+}
+float fractional(float x) { return x - std::floor(x); }
+// Steps of the branches' shifts (splitting): 1 / golden ratio, 1 / plastic number.
+constexpr float kGolden = 0.618033988749895f;
+constexpr float kPlastic = 0.754877666246693f;
+
 // Adjoint-driven roulette (GuideSettings::adjointRoulette): the first bounce it may end a
 // path at, the least survival probability (bounds a survivor's weight), and the confidence a
 // region needs before its Q is trusted.
@@ -203,13 +213,9 @@ constexpr float kRouletteConfidence = 0.5f;
 
 }  // namespace
 
-DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si,
-                                                                const BSDF& bsdf,
-                                                                GuideMixture& guide,
-                                                                Sampler& sampler) const {
+DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
+                                                GuideMixture& guide, float uc, Vec2 u) const {
     DirectionSample ds;
-    float uc = sampler.get1D();
-    Vec2 u = sampler.get2D();
     if (!guide.guide.valid()) {
         BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
         if (!bs.valid()) return ds;
@@ -694,6 +700,11 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             }
             if (lastVertex) break;
 
+            // The sample of the next direction: drawn before splitting's own, so that a path's
+            // direction here takes the same dimensions whether it splits or not.
+            const float uc = sampler.get1D();
+            const Vec2 u = sampler.get2D();
+
             // Splitting: how many paths continue from here (r, rounded stochastically).
             float splitRatio = 1.f;
             int splitCount = 1, retBase = 0;
@@ -711,8 +722,17 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                     branchesLeft -= splitCount - 1;
                 }
             }
+            // Each branch's direction from the vertex's sample shifted by the k-th of splitCount
+            // points spread over the unit square (k / n in x, a golden-ratio step in y, and a
+            // step of its own for uc): every branch's sample is uniform, as the path's own, so
+            // each branch is an unbiased estimate (their number, rounded from an independent
+            // dimension, is independent of them), and together they cover the square evenly
+            // (stratified splitting) instead of drawing dimensions of their own.
             for (int k = 1; k < splitCount; ++k) {
-                DirectionSample dk = sampleDirection(si, bsdf, vertexGuide, sampler);
+                const float t = float(k) / float(splitCount);
+                const Vec2 uk(shiftUnit(u.x, t), shiftUnit(u.y, fractional(float(k) * kGolden)));
+                const float uck = shiftUnit(uc, fractional(float(k) * kPlastic));
+                DirectionSample dk = sampleDirection(si, bsdf, vertexGuide, uck, uk);
                 if (!(dk.pdf > 0.f) || isBlack(dk.f)) continue;
                 Branch& b = branches[numBranches];
                 b.s = s;
@@ -728,8 +748,8 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 ++numBranches;
             }
 
-            // The next direction (the guiding seam), and what the guide learns from it.
-            DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, sampler);
+            // What the guide learns from the path's own direction.
+            DirectionSample ds = sampleDirection(si, bsdf, vertexGuide, uc, u);
 
             {
                 GuideTimer timer(s.clock);

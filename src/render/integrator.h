@@ -191,8 +191,10 @@ private:
         guideMix(g);
         return g.confidence;
     }
+    // The direction at a surface vertex from the sample (uc, u): uc picks a lobe's own choice
+    // or the guide's part, u the direction (u.x first the guide or the BSDF).
     DirectionSample sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
-                                    GuideMixture& guide, Sampler& sampler) const;
+                                    GuideMixture& guide, float uc, Vec2 u) const;
     // The selection probability of a vertex's guide: learned (mix=learn, where the field has
     // one) or the mix setting.
     float guideSelection(const guiding::VertexGuide& guide) const {
