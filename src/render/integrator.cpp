@@ -710,7 +710,12 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             int splitCount = 1, retBase = 0;
             if (guide_.splitMax > 1 && sampleGuide.valid() && pixelEstimate > 0.f && !media &&
                 !bsdf.subsurface() && guideConfidence(vertexGuide) >= kRouletteConfidence) {
-                const float expected = luminance(s.beta) * luminance(bsdf.f(si.wo, query.n)) *
+                // The diffuse lobes' light: what the learned irradiance predicts (a glossy
+                // lobe's light comes from its reflection direction, not from E / pi).
+                constexpr BxDFFlags kDiffuseLobes =
+                    BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Diffuse;
+                const float expected = luminance(s.beta) *
+                                       luminance(bsdf.f(si.wo, query.n, kDiffuseLobes)) *
                                        sampleGuide.irradianceEstimate(query.n);
                 const float r = expected / (guide_.splitWindow * pixelEstimate);
                 if (r > 1.f && std::isfinite(r)) {
