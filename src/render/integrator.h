@@ -120,12 +120,13 @@ struct GuideSettings {
     // rr-window: the weight window's lower edge as a share of the pixel estimate.
     float rouletteWindow = 0.1f;
     // split=N (1 = off): a guided surface vertex whose expected contribution (throughput x
-    // f(wo, n) x the learned irradiance) exceeds splitWindow x the pixel's estimate continues
-    // as up to N paths, each with 1 / r of the throughput (r the ratio, rounded
-    // stochastically): the splitting half of Vorba and Krivanek 2016. Each branch trains on
-    // its own light (PathRecorder::split). Like the adjoint roulette it waits for the pixel
-    // estimates. The default 8 with window 3: breakfast 0.55x-0.57x of the error without it
-    // at equal time, the other reference scenes within +-6% (docs/GUIDING.md, `split`).
+    // the diffuse lobes' f(wo, n) x the learned irradiance) exceeds splitWindow x the pixel's
+    // estimate continues as up to N paths, each with 1 / r of the throughput (r the ratio,
+    // rounded stochastically): the splitting half of Vorba and Krivanek 2016. Each branch
+    // trains on its own light (PathRecorder::split). Like the adjoint roulette it waits for
+    // the pixel estimates. The default 8 with window 3: breakfast 0.55x-0.57x of the error
+    // without it at equal time, the other reference scenes within +-6% (docs/GUIDING.md,
+    // `split`).
     int splitMax = 8;
     float splitWindow = 3.f;
 };
