@@ -74,13 +74,11 @@ class BSDF {
     };
     LobeCounts lobeCounts() const {
         constexpr BxDFFlags kSmooth = BxDFFlags::All & ~BxDFFlags::Specular;
-        constexpr BxDFFlags kDiffuse =
-            BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Diffuse;
         LobeCounts c;
         c.all = n_;
         for (int i = 0; i < n_; ++i) {
             c.smooth += matchesFlags(flags_[i], kSmooth) ? 1 : 0;
-            c.diffuse += matchesFlags(flags_[i], kDiffuse) ? 1 : 0;
+            c.diffuse += matchesFlags(flags_[i], kDiffuseLobes) ? 1 : 0;
         }
         return c;
     }

@@ -38,6 +38,9 @@ inline constexpr bool hasAny(BxDFFlags a, BxDFFlags b) { return uint8_t(a & b) !
 inline constexpr bool matchesFlags(BxDFFlags lobe, BxDFFlags requested) {
     return (lobe & requested) == lobe;
 }
+// The diffuse lobes, reflecting or transmitting (a request for matchesFlags / BSDF::f).
+inline constexpr BxDFFlags kDiffuseLobes =
+    BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Diffuse;
 
 // Which quantity is being transported; affects the eta^2 scaling of transmission (pbrt-v3).
 enum class TransportMode : uint8_t { Radiance, Importance };

@@ -27,11 +27,11 @@ Distribution1D::Distribution1D(const float* f, int n) {
     }
     cdf_[n] = 1.f;
     if (n >= kBucketMin) {
-        buckets_ = n / kPiecesPerBucket;
-        bucketStart_.resize(size_t(buckets_) + 1);
-        for (int k = 0; k < buckets_; ++k)
-            bucketStart_[size_t(k)] = searchCdf(float(k) / float(buckets_), 0, n);
-        bucketStart_[size_t(buckets_)] = n;
+        const int buckets = n / kPiecesPerBucket;
+        bucketStart_.resize(size_t(buckets) + 1);
+        for (int k = 0; k < buckets; ++k)
+            bucketStart_[size_t(k)] = searchCdf(float(k) / float(buckets), 0, n);
+        bucketStart_[size_t(buckets)] = n;
     }
 }
 
@@ -53,7 +53,8 @@ int Distribution1D::searchCdf(float u, int lo, int hi) const {
 int Distribution1D::findInterval(float u) const {
     const int n = count();
     if (!bucketStart_.empty() && u >= 0.f && u < 1.f) {
-        const int k = std::min(static_cast<int>(u * float(buckets_)), buckets_ - 1);
+        const int buckets = static_cast<int>(bucketStart_.size()) - 1;
+        const int k = std::min(static_cast<int>(u * float(buckets)), buckets - 1);
         const int lo = bucketStart_[size_t(k)], hi = bucketStart_[size_t(k) + 1];
         // The answer i, if cdf[i] <= u < cdf[i + 1] (cdf_ has n + 1 entries).
         if (cdf_[size_t(lo)] <= u) {

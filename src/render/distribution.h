@@ -58,8 +58,7 @@ class Distribution1D {
     // same index. A bucket per piece was no faster and takes 16 times the memory.
     static constexpr int kBucketMin = 64;
     static constexpr int kPiecesPerBucket = 16;
-    int buckets_ = 0;
-    std::vector<int> bucketStart_;  // buckets_ + 1 entries, or none
+    std::vector<int> bucketStart_;  // one entry per bucket and the end (n), or none
     // Density of piece i relative to the unit interval (uniform fallback when all zero).
     float pieceDensity(int i) const { return uniform_ ? 1.f : func_[i] / funcInt_; }
 

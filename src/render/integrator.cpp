@@ -712,8 +712,6 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 !bsdf.subsurface() && guideConfidence(vertexGuide) >= kRouletteConfidence) {
                 // The diffuse lobes' light: what the learned irradiance predicts (a glossy
                 // lobe's light comes from its reflection direction, not from E / pi).
-                constexpr BxDFFlags kDiffuseLobes =
-                    BxDFFlags::Reflection | BxDFFlags::Transmission | BxDFFlags::Diffuse;
                 const float expected = luminance(s.beta) *
                                        luminance(bsdf.f(si.wo, query.n, kDiffuseLobes)) *
                                        sampleGuide.irradianceEstimate(query.n);

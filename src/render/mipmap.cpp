@@ -183,15 +183,17 @@ T MipMap<T>::bilerp(int level, const Vec2& st) const {
     float fs = std::floor(s), ft = std::floor(t);
     int s0 = int(fs), t0 = int(ft);
     float ds = s - fs, dt = t - ft;
+    T t00, t01, t10, t11;  // t01: one row down
     if (s0 >= 0 && t0 >= 0 && s0 < l.width - 1 && t0 < l.height - 1) {
-        // All four texels inside the level (the usual case): no wrapping, the same sum.
+        // All four texels inside the level (the usual case): read without wrapping.
         const T* row0 = &l.texels[size_t(t0) * size_t(l.width) + size_t(s0)];
         const T* row1 = row0 + l.width;
-        return (1 - ds) * (1 - dt) * row0[0] + (1 - ds) * dt * row1[0] +
-               ds * (1 - dt) * row0[1] + ds * dt * row1[1];
+        t00 = row0[0], t10 = row0[1], t01 = row1[0], t11 = row1[1];
+    } else {
+        t00 = texel(level, s0, t0), t10 = texel(level, s0 + 1, t0);
+        t01 = texel(level, s0, t0 + 1), t11 = texel(level, s0 + 1, t0 + 1);
     }
-    return (1 - ds) * (1 - dt) * texel(level, s0, t0) + (1 - ds) * dt * texel(level, s0, t0 + 1) +
-           ds * (1 - dt) * texel(level, s0 + 1, t0) + ds * dt * texel(level, s0 + 1, t0 + 1);
+    return (1 - ds) * (1 - dt) * t00 + (1 - ds) * dt * t01 + ds * (1 - dt) * t10 + ds * dt * t11;
 }
 
 template <typename T>
