@@ -43,6 +43,7 @@ float GuidingField::pdfAt(int region, const glm::vec3&, const glm::vec3& w, int*
 void GuidingField::recordSpot(int, int, const glm::vec3&, const glm::vec3&, const glm::vec3&,
                               float, int) {}
 bool GuidingField::learnsSpots() const { return false; }
+bool GuidingField::guidesMedia() const { return false; }
 bool GuidingField::enableChoices(int) { return false; }
 GuidingField::Choice GuidingField::choice(int) const { return Choice(); }
 void GuidingField::recordChoice(int, int, int, float) {}

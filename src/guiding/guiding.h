@@ -124,6 +124,10 @@ public:
     // The region for a vertex; -1 = no data there: use the BSDF (or the phase function). A
     // backend that guides on surfaces only answers -1 to medium queries.
     virtual int locate(const VertexQuery& q) const = 0;
+    // Whether locate() can find a region for a medium vertex at all (false: the integrator
+    // skips the lookup, the medium request and the guide's sample dimension at every medium
+    // vertex). Default: false.
+    virtual bool guidesMedia() const;
     // A hint that locate(q) follows soon (q.p and q.patch are set, q.n may not be yet): a
     // backend may start loading what it will read. No effect on results. Default: nothing.
     virtual void prefetch(const VertexQuery& q) const;

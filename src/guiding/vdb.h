@@ -141,6 +141,7 @@ public:
     // The medium vertices' tables (nullptr: no media or volume=0); their regions follow the
     // surface regions: region = numRegions() + cell.
     const VdbVolume* volume() const { return volume_.get(); }
+    bool guidesMedia() const override { return volume_ != nullptr; }
     // Bytes of the OpenVDB tree alone.
     size_t gridBytes() const;
     // How lookup() reads the grid (benchmarks; not thread-safe against running lookups):

@@ -354,7 +354,7 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
                                                                       GuideMixture& guide,
                                                                       Sampler& sampler) const {
     DirectionSample ds;
-    const float uc = guide_.field ? sampler.get1D() : 0.f;
+    const float uc = guide_.field && guide_.field->guidesMedia() ? sampler.get1D() : 0.f;
     Vec2 u = sampler.get2D();
     const float mix = guideMix(guide);
     ds.scale = guide.scale;
@@ -428,7 +428,7 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     if (bounces >= maxDepth_) return Step::End;
     const Vec3 p = s.ray.o + ms.t * s.ray.d, wo = -s.ray.d;
     guiding::VertexGuide guide;
-    if (guide_.field) {
+    if (guide_.field && guide_.field->guidesMedia()) {
         GuideTimer timer(s.clock);
         guide = guide_.field->guide(guiding::VertexQuery::inMedium(p));
         if (!guide.valid()) rec.requestMedium(p);
@@ -581,21 +581,22 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             const bool found = scene_.intersect(s.ray, &si);
             const bool lastDirection = bounces + 1 >= maxDepth_;
             const bool wantsRegion = field && (!lastDirection || rec.bootstraps());
-            // The lookup below reads a table entry for si.p: start loading it (a cache miss
-            // otherwise; the material evaluation runs in between).
-            guiding::VertexQuery query;
-            if (found && wantsRegion) {
-                GuideTimer timer(s.clock);
-                query.p = si.p;
-                if (guide_.patches) query.patch = guide_.patches->key(si);
-                field->prefetch(query);
-            }
 
             // Media: a free flight to the hit; a scattering event is a medium vertex.
             if (media && s.pm.medium >= 0) {
                 const Step step = mediumStep(s, found, si, bounces, sampler, stats, rec);
                 if (step == Step::End) break;
                 if (step == Step::Scattered) continue;
+            }
+            // The lookup below reads a table entry for a surface vertex at si.p: start loading
+            // it (a cache miss otherwise; the emission and material evaluations run in
+            // between). Not at medium boundaries, which the path passes without a vertex.
+            guiding::VertexQuery query;
+            if (found && wantsRegion && si.material >= 0) {
+                GuideTimer timer(s.clock);
+                query.p = si.p;
+                if (guide_.patches) query.patch = guide_.patches->key(si);
+                field->prefetch(query);
             }
 
             // Emission reached by the previous scattering (or seen by the camera), weighted by

@@ -197,6 +197,9 @@ TEST(HemiField, LookupOnPlaneSidesAndAngle) {
     EXPECT_EQ(down, up + 1);  // same point, the other side
     EXPECT_EQ(f->regionNormal(up), glm::vec3(0, 0, 1));
     EXPECT_EQ(f->regionNormal(down), glm::vec3(0, 0, -1));
+    // Surfaces only: no region in a medium, and the integrator is told so.
+    EXPECT_EQ(f->lookupMedium(p), -1);
+    EXPECT_FALSE(f->guidesMedia());
     // The nearest point by brute force.
     float best = FLT_MAX;
     int bestRegion = -1;

@@ -47,12 +47,15 @@ TEST(VdbVolume, OnlyScenesWithMediaGetTablesAndParametersAreChecked) {
     ASSERT_TRUE(plain);
     EXPECT_EQ(plain->volume(), nullptr);
     EXPECT_EQ(plain->lookupMedium(glm::vec3(0.5f)), -1);
+    EXPECT_FALSE(plain->guidesMedia());
     auto off = makeVdb(foggyPlane(), {{"volume", "0"}});
     ASSERT_TRUE(off);
     EXPECT_EQ(off->volume(), nullptr);
+    EXPECT_FALSE(off->guidesMedia());  // the integrator then skips medium lookups
     auto on = makeVdb(foggyPlane(), {{"volume-voxel", "4"}});
     ASSERT_TRUE(on);
     ASSERT_NE(on->volume(), nullptr);
+    EXPECT_TRUE(on->guidesMedia());
     EXPECT_DOUBLE_EQ(on->volume()->voxelSize(), 0.25);
     EXPECT_EQ(on->volume()->dims(), glm::ivec3(4, 4, 2));
     EXPECT_EQ(on->volume()->strata(), 128);
