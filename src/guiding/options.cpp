@@ -23,10 +23,10 @@ const std::vector<GuideOption>& guideOptions() {
          "pixel's estimate (adjoint), or pbrt-v3's on the throughput"},
         {"rr-window", O::kBoth, kIntegrator, "0.1", "a number in (0, 1]",
          "the adjoint roulette's window: paths below this share of the pixel estimate play"},
-        {"split", O::kBoth, kIntegrator, "8", "an integer in 1..64",
+        {"split", O::kBoth, kIntegrator, "16", "an integer in 1..64",
          "splitting: a vertex whose expected contribution exceeds split-window x the pixel's "
          "estimate continues as up to this many paths (1: off)"},
-        {"split-window", O::kBoth, kIntegrator, "3", "a positive number",
+        {"split-window", O::kBoth, kIntegrator, "1", "a positive number",
          "split: the multiple of the pixel's estimate above which a path splits"},
         {"lights", O::kBoth, kIntegrator, "learned", "\"learned\" or \"scene\"",
          "next-event estimation's light selection: learned per region from what its shadow "

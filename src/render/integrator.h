@@ -124,11 +124,12 @@ struct GuideSettings {
     // estimate continues as up to N paths, each with 1 / r of the throughput (r the ratio,
     // rounded stochastically): the splitting half of Vorba and Krivanek 2016. Each branch
     // trains on its own light (PathRecorder::split). Like the adjoint roulette it waits for
-    // the pixel estimates. The default 8 with window 3: breakfast 0.55x-0.57x of the error
-    // without it at equal time, the other reference scenes within +-6% (docs/GUIDING.md,
-    // `split`).
-    int splitMax = 8;
-    float splitWindow = 3.f;
+    // the pixel estimates. The default 16 with window 1 (session 36; 8 with window 3 before):
+    // at 30 s against plain path tracing breakfast 0.10 (0.15 with 8 / 3), cornell-box 0.74
+    // (0.79), caustic-glass 0.75 (0.86), conference-room 0.85 (0.96), killeroo 1.04 (0.96)
+    // (docs/GUIDING.md, `split`).
+    int splitMax = 16;
+    float splitWindow = 1.f;
 };
 
 class Rng;

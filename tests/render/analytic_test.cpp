@@ -599,7 +599,7 @@ TEST(AdjointRoulette, EnclosureStaysExact) { expectAdjointRouletteExact(12, "0.1
 // remainder is below its pixel's estimate is at risk).
 TEST(AdjointRoulette, ShallowPathsStayExact) { expectAdjointRouletteExact(3, "1"); }
 
-// split=N (the default 8): a path whose expected contribution exceeds split-window x its
+// split=N (the default 16): a path whose expected contribution exceeds split-window x its
 // pixel's estimate continues as several, each with a share of the throughput. With a window of 0.05 nearly
 // every guided vertex of a 12-bounce enclosure splits (up to 32 branches per camera path):
 // the mean stays the exact series, and the image differs from the unsplit one.
