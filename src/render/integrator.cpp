@@ -352,9 +352,10 @@ Spectrum PathIntegrator::transmittance(Vec3 o, const Vec3& d, float tMax, int me
 
 DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
                                                                       GuideMixture& guide,
+                                                                      bool guided,
                                                                       Sampler& sampler) const {
     DirectionSample ds;
-    const float uc = guide_.field && guide_.field->guidesMedia() ? sampler.get1D() : 0.f;
+    const float uc = guided ? sampler.get1D() : 0.f;
     Vec2 u = sampler.get2D();
     const float mix = guideMix(guide);
     ds.scale = guide.scale;
@@ -428,7 +429,8 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     if (bounces >= maxDepth_) return Step::End;
     const Vec3 p = s.ray.o + ms.t * s.ray.d, wo = -s.ray.d;
     guiding::VertexGuide guide;
-    if (guide_.field && guide_.field->guidesMedia()) {
+    const bool guided = guide_.field && guide_.field->guidesMedia();
+    if (guided) {
         GuideTimer timer(s.clock);
         guide = guide_.field->guide(guiding::VertexQuery::inMedium(p));
         if (!guide.valid()) rec.requestMedium(p);
@@ -439,7 +441,7 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     GuideMixture vertexGuide{sampleGuide, 1.f};
     vertexGuide.clock = s.clock;
     s.L += s.beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, s.pm, sampler, stats);
-    DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, sampler);
+    DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, guided, sampler);
     {
         GuideTimer timer(s.clock);
         rec.mediumScattered(guide, ds);

@@ -244,9 +244,9 @@ private:
                                const PathMedium& pm, Sampler& sampler, PathStats& stats) const;
     // The direction-sampling seam at a medium vertex: the phase function, or at a region the
     // guide with probability guideMix, mixed with it (f = the phase value; one 1D dimension
-    // more when a field is set); mixturePdf gives that strategy's pdf.
+    // more where the field guides media: `guided`); mixturePdf gives that strategy's pdf.
     DirectionSample sampleMediumDirection(const Vec3& wo, float g, GuideMixture& guide,
-                                          Sampler& sampler) const;
+                                          bool guided, Sampler& sampler) const;
     // Transmittance of the segment o + t d, t in (0, tMax), starting in `medium`: through
     // medium boundaries (interface-only surfaces), zero at any other surface.
     Spectrum transmittance(Vec3 o, const Vec3& d, float tMax, int medium, Rng& rng,
