@@ -117,13 +117,15 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     guiding::GuidingField* field = options.guide.field;
     const int totalSpp = scene.sampler->samplesPerPixel();
     const bool timed = options.timeBudget > 0.0;
-    // Passes: plain path tracing takes one sample per pixel per pass from one sequence per
-    // pixel. A guided render learns between passes, with passes sized half the samples so far
-    // (1, 1, 1, 1, 2, 3, 4, 6, 9, ...; at most 64, and fewer for a large image: below):
-    // frequent updates early. Its samples continue the same sequence per pixel, or
-    // (samples=independent, GuideSettings::independentPasses) come from a set of the pass's
-    // own (Sampler::passSampler).
-    // Halves learned better than doubling pass sizes (docs/BENCHMARKS_HISTORY.md).
+    // Passes sized half the samples so far (1, 1, 1, 1, 2, 3, 4, 6, 9, ...; at most 64, and
+    // fewer for a large image: below), each pass's samples the next of one sequence per
+    // pixel. A guided render learns between passes: frequent updates early; its samples may
+    // instead (samples=independent, GuideSettings::independentPasses) come from a set of the
+    // pass's own (Sampler::passSampler). Halves learned better than doubling pass sizes
+    // (docs/BENCHMARKS_HISTORY.md). Plain path tracing took one sample per pixel per pass
+    // until session 37: each pass ends in a wait for the last tile and a merge, about 3.5 ms
+    // of wall time per pass on a 256x160 image, 5-7% of a plain render of metal-spheres
+    // (docs/BENCHMARKS.md, session 37).
     bool guided = field != nullptr;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
     // that reaches autoSpp (or a quarter of a time budget) is measured, then a plain pass of
@@ -159,7 +161,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // its share of the pixels (the same cap on every rank: they render the same passes).
     const long long pixelsPerProcess =
         std::max<long long>(1, film.sampleBounds().area() / (ranks ? ranks->size() : 1));
-    const int maxGuidedPass = int(std::clamp<long long>(
+    const int maxPass = int(std::clamp<long long>(
         std::max(options.maxPassPaths, 1ll) / pixelsPerProcess, 1, 64));
     std::unique_ptr<PathIntegrator> plainIntegrator;
     std::unique_ptr<PassMoments> guidedMoments, plainMoments;
@@ -333,7 +335,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         endTrial();
     };
     for (;;) {
-        int count = guided ? std::clamp(result.spp / 2, 1, maxGuidedPass) : 1;
+        int count = std::clamp(result.spp / 2, 1, maxPass);
         if (trial == Trial::MeasurePlain)
             count = guidedCount >= kAutoPartsFrom ? guidedCount / kAutoFirstPart : guidedCount;
         if (trial == Trial::MeasurePlainRest) count = guidedCount - plainCount;
