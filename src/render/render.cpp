@@ -123,9 +123,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // instead (samples=independent, GuideSettings::independentPasses) come from a set of the
     // pass's own (Sampler::passSampler). Halves learned better than doubling pass sizes
     // (docs/BENCHMARKS_HISTORY.md). Plain path tracing took one sample per pixel per pass
-    // until session 37: each pass ends in a wait for the last tile and a merge, about 3.5 ms
-    // of wall time per pass on a 256x160 image, 5-7% of a plain render of metal-spheres
-    // (docs/BENCHMARKS.md, session 37).
+    // until session 37: each pass ends in a wait for the last tile and for the worker to
+    // wake, about 3.5 ms of wall time per pass on a 256x160 image; the larger passes take
+    // 0.81 of the time on killeroo-simple, 0.95 on metal-spheres, 0.98 on cornell-box
+    // (docs/BENCHMARKS_HISTORY.md, session 37).
     bool guided = field != nullptr;
     // The auto trial (GuideSettings::autoSpp): the first guided pass of at least 2 samples
     // that reaches autoSpp (or a quarter of a time budget) is measured, then a plain pass of
