@@ -110,13 +110,14 @@ TEST(Render, PassesGrowWithinTheirPathBudget) {
         return sizes;
     };
     // Halves of the samples so far: 1, 1, 1, 1, 2, 3, 4, 6, 9, 14, 21, then the 1 left.
-    EXPECT_EQ(passSizes("hemi", 0), (std::vector<int>{1, 1, 1, 1, 2, 3, 4, 6, 9, 14, 21, 1}));
+    const std::vector<int> halves{1, 1, 1, 1, 2, 3, 4, 6, 9, 14, 21, 1};
+    EXPECT_EQ(passSizes("hemi", 0), halves);
     // A budget of 3 samples per pixel (and a bit): no pass above 3.
     const std::vector<int> three = passSizes("hemi", 3 * pixels + pixels / 2);
     EXPECT_EQ(*std::max_element(three.begin(), three.end()), 3);
     // Below one sample per pixel: one per pass.
     EXPECT_EQ(passSizes("hemi", pixels / 2), std::vector<int>(kSpp, 1));
-    EXPECT_EQ(passSizes("none", 0), (std::vector<int>{1, 1, 1, 1, 2, 3, 4, 6, 9, 14, 21, 1}));
+    EXPECT_EQ(passSizes("none", 0), halves);
     EXPECT_EQ(passSizes("none", pixels / 2), std::vector<int>(kSpp, 1));
 }
 
