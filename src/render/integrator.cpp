@@ -576,13 +576,16 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
             // learned Q, the light of whole returns, overstates what it can find there, and its
             // truncated return would understate Q for the vertices before the last. It samples
             // the BSDF and records no return (Eq. 1 targets, bootstrapped from Q, are learned
-            // there as everywhere), so a surface vertex looks up a region only before it or to
-            // bootstrap.
+            // there as everywhere), so a surface vertex looks up a region only before it, to
+            // bootstrap, or for its next-event estimation's learned light choice (lights=learned:
+            // at veach-mis' only vertex, maxdepth 1, it has 0.21x the error per sample of the
+            // scene's light sampler; docs/BENCHMARKS_HISTORY.md, session 38).
             SurfaceInteraction si;
             ++stats.rays;
             const bool found = scene_.intersect(s.ray, &si);
             const bool lastDirection = bounces + 1 >= maxDepth_;
-            const bool wantsRegion = field && (!lastDirection || rec.bootstraps());
+            const bool wantsRegion =
+                field && (!lastDirection || rec.bootstraps() || guide_.learnLights);
 
             // Media: a free flight to the hit; a scattering event is a medium vertex.
             if (media && s.pm.medium >= 0) {
