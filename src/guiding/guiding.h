@@ -48,6 +48,7 @@ struct GuidingStats {
     uint64_t rejectedRecords = 0;   // bad slot/region or direction outside the hemisphere
     uint64_t activeVoxels = 0;      // vdb backend: active voxels of the grid (0 otherwise)
     uint64_t learnedRegions = 0;    // regions with tables of their own (hemi, vdb surfaces)
+    uint64_t cappedRegions = 0;     // of those, regions that stopped learning (learn-cap)
     uint64_t selectionRegions = 0;  // regions with a learned selection (mix=learn)
     double selectionMean = 0.0;     // their mean selection probability
 };
@@ -204,6 +205,11 @@ public:
     // integrator multiplies its guide/BSDF mixture probability by it, so regions with little
     // data sample mostly the BSDF. Frozen between passes like the policy. Default: 1.
     virtual float confidence(int region) const;
+    // Whether `region` still learns: false once it holds the records the field's learn-cap
+    // asks for (its guide then stays as learned, and record() and recordSpot() ignore it),
+    // so that the integrator can skip the training work of its vertices. Frozen between
+    // passes like the policy. Default: true.
+    virtual bool learns(int region) const;
 
     // The learned probability of choosing the guide over the BSDF (or phase function) at a
     // region, frozen per pass like the policy, or -1 where none has been learned (the
@@ -321,6 +327,8 @@ public:
     const glm::vec3& position() const { return p_; }
     // How far the region's policy is trusted, in [0, 1].
     float confidence() const { return field_->confidence(region_); }
+    // GuidingField::learns for the region.
+    bool learns() const { return field_->learns(region_); }
     // The learned probability of choosing the guide, or -1 where none is learned.
     float selection() const { return field_->selection(region_); }
     // GuidingField::choice for the region (none for an invalid guide).

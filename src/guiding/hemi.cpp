@@ -330,6 +330,7 @@ glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float
 void HemiField::recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
                            const glm::vec3& hit, float light, int bin) {
     if (!spots_ || !validRegion(region)) return;  // (spots exclude directions=tree)
+    if (!frames_[size_t(region)].learns) return;
     // Only where the strata have learned enough to tell a spot from their estimate.
     if (frames_[size_t(region)].confidence < 0.5f) return;
     const int j = stratumOf(region, w, bin >= 0 ? bin & ~kSpotBin : bin);
@@ -454,6 +455,7 @@ void HemiField::record(int slot, int region, const glm::vec3& w, float target, i
         return;
     }
     if (bin >= 0 && (bin & kSpotBin)) return;  // sampled by a spot lobe (sampleAt)
+    if (validRegion(region) && !frames_[size_t(region)].learns) return;
     table_.record(slot, region, target, [&] { return stratumOf(region, w, bin); });
 }
 
@@ -467,6 +469,7 @@ void HemiField::updateRegion(int region, const double* q) {
     }
     RegionFrame& rf = frames_[size_t(region)];
     rf.confidence = table_.confidence(size_t(region), params_.warmup);
+    rf.learns = table_.belowCap(size_t(region), params_.learnCap);
     // buildPolicy's normalisation: p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n, or 1 / n
     // where the sum is not positive and finite (then Q_j = 0 for all j).
     double sum = 0.0;
@@ -634,6 +637,7 @@ std::string HemiField::describe() const {
 GuidingStats HemiField::stats() const {
     GuidingStats s = trees_ ? trees_->stats() : table_.stats();
     s.learnedRegions = learnedRegions();
+    for (const RegionFrame& f : frames_) s.cappedRegions += f.learns ? 0 : 1;
     return s;
 }
 

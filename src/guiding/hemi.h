@@ -46,6 +46,10 @@ struct HemiParams {
     // Confidence of a region = visits / (visits + warmup * strata): the integrator scales its
     // mixture probability by it, so barely trained regions sample mostly the BSDF.
     double warmup = 8.0;
+    // A region stops learning once it holds learnCap records per stratum on average (0:
+    // never): its guide stays as learned and its vertices skip the training work, which was
+    // most of the guide's cost in long renders of scenes it cannot improve (docs/GUIDING.md).
+    double learnCap = 256.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree
@@ -145,6 +149,9 @@ public:
     // total divided by cos_j. (radiance() with epsilon = 1, where the CDF holds no Q.)
     float policyRadiance(int region, const glm::vec3& w, int bin = -1) const override;
     float confidence(int region) const override;
+    bool learns(int region) const override {
+        return validRegion(region) && frames_[size_t(region)].learns;
+    }
     float selection(int region) const override;
     void recordSelection(int slot, int region, const SelectionSample& s) override;
     void beginPass(int numSlots) override;
@@ -309,6 +316,7 @@ private:
         glm::vec3 moment{0.f};
         float confidence = 0.f;   // visits / (visits + warmup * strata), frozen per pass
         float policyScale = 0.f;  // sum_j Q_j cos_j / (1 - epsilon); 0 for a uniform CDF
+        bool learns = true;       // below the learn cap (HemiParams::learnCap), frozen per pass
     };
     std::vector<RegionFrame> frames_;
     // Per stratum, 1 / the cosine factor of the policy (1 without the cosine product), and

@@ -58,6 +58,9 @@ const std::vector<GuideOption>& guideOptions() {
          "neighbours (0: off)"},
         {"warmup", O::kBoth, kField, "8", "a number in [0, 1e9]",
          "records per stratum before a region's guide gets the full mix (0: at once)"},
+        {"learn-cap", O::kBoth, kField, "256", "a number in [0, 1e9]",
+         "records per stratum (a region's mean) after which a region stops learning and "
+         "keeps its guide (0: never)"},
         {"normal-angle", O::kBoth, kField, "30", "degrees in (0, 180)",
          "admissible deviation between a vertex's normal and a region's"},
         {"points", O::kBoth, kField,

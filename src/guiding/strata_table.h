@@ -78,10 +78,19 @@ public:
     float confidence(size_t region, double warmup) const {
         const double w = warmup * double(strata_);
         if (!(w > 0.0)) return 1.f;
+        const double total = visitsTotal(region);
+        return float(total / (total + w));
+    }
+    // Whether a region has fewer than cap records per stratum on average (cap 0: always).
+    bool belowCap(size_t region, double cap) const {
+        return !(cap > 0.0) || visitsTotal(region) < cap * double(strata_);
+    }
+    // The records a region has learned, over all its strata.
+    double visitsTotal(size_t region) const {
         const uint64_t* v = visits(region);
         double total = 0.0;
         for (int j = 0; j < strata_; ++j) total += double(int64_t(v[j]));  // < 2^63
-        return float(total / (total + w));
+        return total;
     }
 
     // Per-pass record buffers (see GuidingField::beginPass/record).

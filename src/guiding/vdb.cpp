@@ -251,11 +251,18 @@ StrataTable::PolicyBuilder VdbField::policy() const {
         buildPolicy(q, cdf);
         if (region < 0 || size_t(region) >= confidence_.size()) return;
         confidence_[size_t(region)] = table_.confidence(size_t(region), params_.warmup);
+        learns_[size_t(region)] = table_.belowCap(size_t(region), params_.learnCap);
     };
 }
 
 void VdbField::resetConfidence() {
     confidence_.assign(table_.regions(), params_.warmup > 0.0 ? 0.f : 1.f);
+    learns_.assign(table_.regions(), 1);
+}
+
+bool VdbField::learns(int region) const {
+    if (volumeCell(region) >= 0) return true;  // medium cells: Eq. 1's records, uncapped
+    return region >= 0 && size_t(region) < learns_.size() && learns_[size_t(region)] != 0;
 }
 
 float VdbField::confidence(int region) const {
@@ -471,6 +478,7 @@ void VdbField::beginPass(int numSlots) {
 
 void VdbField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
     if (const int cell = volumeCell(region); cell >= 0) return volume_->record(slot, cell, w, target);
+    if (!learns(region)) return;
     table_.record(slot, region, target, [&] { return stratumOf(region, w, bin); });
 }
 
@@ -490,6 +498,7 @@ size_t VdbField::bytes() const {
     return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
            clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
            frames_.capacity() * sizeof(Frame) + confidence_.capacity() * sizeof(float) +
+           learns_.capacity() +
            3 * centreX_.capacity() * sizeof(float) + (volume_ ? volume_->bytes() : 0);
 }
 
@@ -528,6 +537,7 @@ GuidingStats VdbField::stats() const {
     GuidingStats s = table_.stats();
     s.activeVoxels = activeVoxels();
     s.learnedRegions = table_.learnedRegions();
+    for (uint8_t l : learns_) s.cappedRegions += l ? 0 : 1;
     if (volume_) {
         const GuidingStats& v = volume_->stats();
         s.records += v.records;

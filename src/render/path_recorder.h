@@ -80,17 +80,19 @@ public:
     // After the throughput took the direction's weight (beta): the vertex's return (it learns
     // the light gathered from here on), and the pending record's next step (a new one at a
     // guided vertex with Eq. 1's targets, carried through a delta vertex, else dropped).
-    // learnsReturn: whether the vertex's guide learns the return.
+    // learnsReturn: whether the vertex's guide learns the return (where its region still
+    // learns: GuidingField::learns).
     void surfaceScattered(const guiding::VertexGuide& guide, bool learnsReturn, bool canGuide,
                           const DirectionSample& ds, const Spectrum& weight, const Spectrum& L,
                           const Spectrum& beta) {
         spotPending_ = false;
-        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices) {
+        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices &&
+            guide.learns()) {
             ret_.v[numRet_++] = ReturnVertex{guide, ds.bin, ds.wi, L, beta};
             spotPending_ = spots_;
         }
         if (!learn_ || split_) return;
-        if (bootstrap_ && guide.valid() && !ds.transmission) {
+        if (bootstrap_ && guide.valid() && !ds.transmission && guide.learns()) {
             pending_ = PendingRecord();
             pending_.guide = guide;
             pending_.w = ds.wi;
@@ -131,7 +133,8 @@ public:
     void branchStarted(const guiding::VertexGuide& guide, bool learnsReturn, int bin,
                        const Vec3& w, const Spectrum& L, const Spectrum& beta) {
         spotPending_ = false;
-        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices) {
+        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices &&
+            guide.learns()) {
             ret_.v[numRet_++] = ReturnVertex{guide, bin, w, L, beta};
             spotPending_ = spots_;
         }

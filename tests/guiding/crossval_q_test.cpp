@@ -47,9 +47,12 @@ struct Cell {
 // estimate the same number: they must agree within 5 standard errors of their difference
 // (each from its cell's sample variance and count).
 TEST(GuideCrossValidation, HemiAndVdbLearnTheSameQ) {
-    // (smooth=0: radiance() is then Q itself, the running mean compared below)
-    auto hemi = make("hemi", {{"points", "16"}, {"strata", "4x4"}, {"smooth", "0"}});
-    auto vdb = make("vdb", {{"voxel", "4"}, {"strata", "4x4"}, {"smooth", "0"}});
+    // (smooth=0: radiance() is then Q itself, the running mean compared below; learn-cap=0:
+    // the mean of every record, however many a cell takes)
+    auto hemi = make("hemi",
+                     {{"points", "16"}, {"strata", "4x4"}, {"smooth", "0"}, {"learn-cap", "0"}});
+    auto vdb = make("vdb",
+                    {{"voxel", "4"}, {"strata", "4x4"}, {"smooth", "0"}, {"learn-cap", "0"}});
     ASSERT_TRUE(hemi && vdb);
     auto* h = dynamic_cast<HemiField*>(hemi.get());
     auto* v = dynamic_cast<VdbField*>(vdb.get());

@@ -99,7 +99,8 @@ TEST(GuidingFactory, NoneAndErrors) {
         {"init", "0"},           {"init", "-1"},        {"init", "inf"},
         {"init", "1e39"},        {"init", "1e400"},     {"epsilon", "1.5"},
         {"epsilon", "-0.1"},     {"knn", "0"},          {"knn", "65"},
-        {"max-mb", "0"},         {"colour", "red"},
+        {"max-mb", "0"},         {"colour", "red"},     {"learn-cap", "-1"},
+        {"learn-cap", "x"},      {"learn-cap", "2e9"},
     };
     for (const auto& [key, value] : bad) {
         GuideConfig cfg;
@@ -475,6 +476,49 @@ TEST(HemiField, SmoothingSpreadsSparseVisitsAndKeepsThePdfExact) {
         chi2::SphereResult r = sphereTest(*f, region, 701, 100000);
         EXPECT_TRUE(r.passed) << r.message;
     }
+}
+
+// learn-cap: a region stops learning (from the next pass on) once it holds learn-cap x strata
+// records, keeps its guide, and ignores its records; the others go on; 0 never stops.
+TEST(HemiField, RegionStopsLearningAtTheCap) {
+    EXPECT_EQ(makeHemi(planeScene())->params().learnCap, 256.0);
+    auto f = makeHemi(planeScene(), {{"learn-cap", "2"}});  // 512 records of 256 strata
+    ASSERT_TRUE(f);
+    const int r = 0;
+    const glm::vec3 n = f->regionNormal(r);
+    const glm::vec3 side = glm::normalize(n + 0.8f * Frame::fromZ(n).s);
+    EXPECT_TRUE(f->learns(r));
+    f->beginPass(2);
+    for (int i = 0; i < 511; ++i) f->record(i % 2, r, n, 1.f);
+    f->endPass();
+    EXPECT_TRUE(f->learns(r));  // 511 < 512
+    EXPECT_EQ(f->stats().cappedRegions, 0u);
+    f->beginPass(1);
+    f->record(0, r, n, 1.f);
+    f->endPass();
+    EXPECT_FALSE(f->learns(r));
+    EXPECT_EQ(f->stats().cappedRegions, 1u);
+    EXPECT_TRUE(f->learns(r + 2));
+    EXPECT_FALSE(f->learns(-1));
+    // Its records are ignored from now on: the policy and the counters stay.
+    const float pdfN = f->pdf(r, n), pdfSide = f->pdf(r, side);
+    const uint64_t records = f->stats().records;
+    f->beginPass(1);
+    for (int i = 0; i < 1000; ++i) f->record(0, r, side, 100.f);
+    f->recordSpot(0, r, glm::vec3(0.f), side, glm::vec3(1.f), 1e4f, -1);
+    f->record(0, r + 2, side, 1.f);
+    f->endPass();
+    EXPECT_EQ(f->pdf(r, n), pdfN);
+    EXPECT_EQ(f->pdf(r, side), pdfSide);
+    EXPECT_EQ(f->stats().records, records + 1);
+    // learn-cap 0: a region never stops.
+    auto g = makeHemi(planeScene(), {{"learn-cap", "0"}});
+    ASSERT_TRUE(g);
+    g->beginPass(1);
+    for (int i = 0; i < 100000; ++i) g->record(0, r, n, 1.f);
+    g->endPass();
+    EXPECT_TRUE(g->learns(r));
+    EXPECT_EQ(g->stats().cappedRegions, 0u);
 }
 
 TEST(HemiField, TrainedSamplingMatchesPdfAndFollowsLight) {

@@ -78,7 +78,7 @@ TEST(VdbFactory, ParametersAndErrors) {
         {"voxel-size", "-1"}, {"voxel-size", "inf"}, {"points", "0"},   {"dirs", "cube"},
         {"init", "0"},       {"epsilon", "2"},      {"cosine", "2"},    {"max-mb", "0"},
         {"knn", "8"},        {"normal-angle", "0"}, {"normal-angle", "180"}, {"normals", "0"},
-        {"normals", "17"},
+        {"normals", "17"},   {"learn-cap", "-1"},
     };
     for (const auto& [key, value] : bad) {
         GuideConfig cfg;
@@ -364,6 +364,34 @@ TEST(VdbField, SampleReportsPdfOfItsDirection) {
         EXPECT_EQ(pdf, 0.f);
         EXPECT_EQ(f->pdf(f->numRegions(), glm::vec3(0, 0, 1)), 0.f);
     }
+}
+
+// learn-cap as hemi's (HemiField.RegionStopsLearningAtTheCap): a surface region stops
+// learning once it holds learn-cap x strata records; its Q stays.
+TEST(VdbField, RegionStopsLearningAtTheCap) {
+    auto f = makeVdb(planeScene(), {{"voxel", "4"}, {"strata", "4"}, {"learn-cap", "1"}});
+    ASSERT_TRUE(f);
+    const glm::vec3 w = glm::normalize(glm::vec3(0.1f, 0.2f, 1.f));
+    const int j = f->stratumOf(0, w);
+    ASSERT_GE(j, 0);
+    EXPECT_TRUE(f->learns(0));
+    for (int n : {8, 7}) {
+        f->beginPass(1);
+        for (int i = 0; i < n; ++i) f->record(0, 0, w, 2.f);
+        f->endPass();
+        EXPECT_TRUE(f->learns(0));  // 8, then 15 of 16 records
+    }
+    f->beginPass(1);
+    for (int i = 0; i < 16; ++i) f->record(0, 0, w, 2.f);
+    f->endPass();
+    EXPECT_FALSE(f->learns(0)) << f->visits(0, j);
+    f->beginPass(1);
+    for (int i = 0; i < 8; ++i) f->record(0, 0, w, 50.f);
+    f->endPass();
+    EXPECT_DOUBLE_EQ(f->q(0, j), 2.0);
+    EXPECT_EQ(f->visits(0, j), 31u);
+    EXPECT_EQ(f->stats().cappedRegions, 1u);
+    EXPECT_TRUE(f->learns(1));
 }
 
 TEST(VdbField, RunningMeanAndEstimates) {
