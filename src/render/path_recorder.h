@@ -85,12 +85,7 @@ public:
     void surfaceScattered(const guiding::VertexGuide& guide, bool learnsReturn, bool canGuide,
                           const DirectionSample& ds, const Spectrum& weight, const Spectrum& L,
                           const Spectrum& beta) {
-        spotPending_ = false;
-        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices &&
-            guide.learns()) {
-            ret_.v[numRet_++] = ReturnVertex{guide, ds.bin, ds.wi, L, beta};
-            spotPending_ = spots_;
-        }
+        addReturn(guide, learnsReturn, ds.bin, ds.wi, L, beta);
         if (!learn_ || split_) return;
         if (bootstrap_ && guide.valid() && !ds.transmission && guide.learns()) {
             pending_ = PendingRecord();
@@ -132,12 +127,7 @@ public:
     // 1 / r); like surfaceScattered's return vertex.
     void branchStarted(const guiding::VertexGuide& guide, bool learnsReturn, int bin,
                        const Vec3& w, const Spectrum& L, const Spectrum& beta) {
-        spotPending_ = false;
-        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices &&
-            guide.learns()) {
-            ret_.v[numRet_++] = ReturnVertex{guide, bin, w, L, beta};
-            spotPending_ = spots_;
-        }
+        addReturn(guide, learnsReturn, bin, w, L, beta);
     }
     // A segment of a split path ended with radiance L (the light of every segment so far):
     // the return vertices from `base` on (the ended segment's) learn now.
@@ -199,6 +189,17 @@ private:
         SelectionVertex v[kMaxSelectionVertices];
     };
 
+    // A return vertex (surfaceScattered, branchStarted) where the vertex learns its return and
+    // its region still learns (GuidingField::learns); a spot record waits for it.
+    void addReturn(const guiding::VertexGuide& guide, bool learnsReturn, int bin, const Vec3& w,
+                   const Spectrum& L, const Spectrum& beta) {
+        spotPending_ = false;
+        if (returns_ && learnsReturn && guide.valid() && numRet_ < kMaxReturnVertices &&
+            guide.learns()) {
+            ret_.v[numRet_++] = ReturnVertex{guide, bin, w, L, beta};
+            spotPending_ = spots_;
+        }
+    }
     // Completes the pending record with `addTarget` (weighted) and records it.
     void flush(float addTarget) {
         if (!pending_.active()) return;
