@@ -386,7 +386,9 @@ float HemiField::selection(int region) const {
 }
 
 void HemiField::recordSelection(int slot, int region, const SelectionSample& s) {
-    if (validRegion(region)) table_.selection().record(slot, region, s);
+    // A region that stopped learning (learn-cap) keeps its selection as well.
+    if (validRegion(region) && frames_[size_t(region)].learns)
+        table_.selection().record(slot, region, s);
 }
 
 float HemiField::radiance(int region, const glm::vec3& w, int bin) const {

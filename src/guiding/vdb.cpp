@@ -468,7 +468,8 @@ float VdbField::selection(int region) const {
 void VdbField::recordSelection(int slot, int region, const SelectionSample& s) {
     if (const int cell = volumeCell(region); cell >= 0)
         return volume_->selection().record(slot, cell, s);
-    if (validRegion(region)) table_.selection().record(slot, region, s);
+    // A region that stopped learning (learn-cap) keeps its selection as well.
+    if (learns(region)) table_.selection().record(slot, region, s);
 }
 
 void VdbField::beginPass(int numSlots) {

@@ -216,7 +216,11 @@ constexpr float kRouletteConfidence = 0.5f;
 DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si, const BSDF& bsdf,
                                                 GuideMixture& guide, float uc, Vec2 u) const {
     DirectionSample ds;
-    if (!guide.guide.valid()) {
+    // Where the guide's probability is 0 (a region whose learned selection is 0, or not yet
+    // confident), the BSDF's sample alone, without the guide's pdf unless a selection sample
+    // needs it.
+    if (!guide.guide.valid() ||
+        (!(guideMix(guide) > 0.f) && !(guide.recordsSelection && guide.guide.learns()))) {
         BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
         if (!bs.valid()) return ds;
         ds.f = bs.f;
@@ -373,7 +377,7 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
         u.x = std::min((u.x - mix) / (1.f - mix), OneMinusEpsilon);
         ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
         if (!(pPhase > 0.f)) return DirectionSample();
-        if (mix > 0.f) {
+        if (mix > 0.f || (guide.recordsSelection && guide.guide.learns())) {
             GuideTimer timer(guide.clock);
             pGuide = guide.guide.pdf(ds.wi, &ds.bin);
         }
@@ -439,6 +443,7 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     const guiding::VertexGuide sampleGuide = guide_.mix > 0.f ? guide : guiding::VertexGuide();
     ++stats.vertices;
     GuideMixture vertexGuide{sampleGuide, 1.f};
+    vertexGuide.recordsSelection = rec.recordsSelection();
     vertexGuide.clock = s.clock;
     s.L += s.beta * sampleLightMedium(p, wo, medium.g(), vertexGuide, s.pm, sampler, stats);
     DirectionSample ds = sampleMediumDirection(wo, medium.g(), vertexGuide, guided, sampler);
@@ -680,6 +685,7 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
                 guide.valid() && guide_.mix > 0.f && !lastDirection ? diffuseShare(lobes) : 0.f;
             const guiding::VertexGuide sampleGuide = share > 0.f ? guide : guiding::VertexGuide();
             GuideMixture vertexGuide{sampleGuide, share};
+            vertexGuide.recordsSelection = rec.recordsSelection();
             vertexGuide.clock = s.clock;
 
             // Next-event estimation at non-specular vertices (first: its shadow ray gives the

@@ -160,6 +160,9 @@ private:
         float mix = -1.f;         // the guide probability: selection x scale, once found
         float confidence = 0.f;   // the region's
         float scale = 0.f;        // confidence x share
+        // Whether the path records this vertex's selection sample (mix=learn, while the
+        // region learns): its guide pdf is then wanted even where the guide probability is 0.
+        bool recordsSelection = false;
         GuideClockSums* clock = nullptr;  // the path's guide clock (render/guide_clock.h), if timed
     };
     float guideMix(GuideMixture& g) const {

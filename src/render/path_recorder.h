@@ -67,11 +67,15 @@ public:
                         float emitted) {
         if (deferred) completeDeferred(si, guide, ds, emitted);
     }
+    // Whether the path records selection samples (mix=learn, until it splits), at vertices
+    // whose region still learns (GuidingField::learns).
+    bool recordsSelection() const { return learnSelection_ && !split_; }
     // Before the throughput takes ds's weight: a selection sample of a guided vertex at
     // sampleGuide (mix=learn), with the path's L and throughput so far.
     void selectionVertex(const guiding::VertexGuide& sampleGuide, const DirectionSample& ds,
                          const Spectrum& L, const Spectrum& beta) {
-        if (!learnSelection_ || split_ || !sampleGuide.valid() || numSel_ >= kMaxSelectionVertices)
+        if (!recordsSelection() || !sampleGuide.valid() || numSel_ >= kMaxSelectionVertices ||
+            !sampleGuide.learns())
             return;
         sel_.v[numSel_++] = SelectionVertex{
             sampleGuide, guiding::SelectionSample{0.f, ds.pdf, ds.pGuide, ds.pOther, ds.scale},

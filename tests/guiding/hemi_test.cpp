@@ -511,6 +511,17 @@ TEST(HemiField, RegionStopsLearningAtTheCap) {
     EXPECT_EQ(f->pdf(r, n), pdfN);
     EXPECT_EQ(f->pdf(r, side), pdfSide);
     EXPECT_EQ(f->stats().records, records + 1);
+    // Its selection samples (mix=learn) too: it keeps the selection it had (none here), while
+    // a region that still learns takes one from the same samples.
+    const guiding::SelectionSample sel{1.f, 1.f, 2.f, 0.5f, 1.f};
+    f->beginPass(1);
+    for (int i = 0; i < 64; ++i) {
+        f->recordSelection(0, r, sel);
+        f->recordSelection(0, r + 2, sel);
+    }
+    f->endPass();
+    EXPECT_EQ(f->selection(r), -1.f);
+    EXPECT_GE(f->selection(r + 2), 0.f);
     // learn-cap 0: a region never stops.
     auto g = makeHemi(planeScene(), {{"learn-cap", "0"}});
     ASSERT_TRUE(g);

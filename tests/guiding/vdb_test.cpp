@@ -392,6 +392,16 @@ TEST(VdbField, RegionStopsLearningAtTheCap) {
     EXPECT_EQ(f->visits(0, j), 31u);
     EXPECT_EQ(f->stats().cappedRegions, 1u);
     EXPECT_TRUE(f->learns(1));
+    // Nor does it learn a selection (mix=learn) any more; region 1, which learns, does.
+    const guiding::SelectionSample sel{1.f, 1.f, 2.f, 0.5f, 1.f};
+    f->beginPass(1);
+    for (int i = 0; i < 64; ++i) {
+        f->recordSelection(0, 0, sel);
+        f->recordSelection(0, 1, sel);
+    }
+    f->endPass();
+    EXPECT_EQ(f->selection(0), -1.f);
+    EXPECT_GE(f->selection(1), 0.f);
 }
 
 TEST(VdbField, RunningMeanAndEstimates) {
