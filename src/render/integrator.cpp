@@ -219,8 +219,7 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si, co
     // Where the guide's probability is 0 (a region whose learned selection is 0, or not yet
     // confident), the BSDF's sample alone, without the guide's pdf unless a selection sample
     // needs it.
-    if (!guide.guide.valid() ||
-        (!(guideMix(guide) > 0.f) && !(guide.recordsSelection && guide.guide.learns()))) {
+    if (!guide.guide.valid() || !needsGuidePdf(guide)) {
         BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
         if (!bs.valid()) return ds;
         ds.f = bs.f;
@@ -377,7 +376,7 @@ DirectionSample PathIntegrator::sampleMediumDirection(const Vec3& wo, float g,
         u.x = std::min((u.x - mix) / (1.f - mix), OneMinusEpsilon);
         ds.wi = sampleHenyeyGreenstein(wo, g, u, &pPhase);
         if (!(pPhase > 0.f)) return DirectionSample();
-        if (mix > 0.f || (guide.recordsSelection && guide.guide.learns())) {
+        if (needsGuidePdf(guide)) {
             GuideTimer timer(guide.clock);
             pGuide = guide.guide.pdf(ds.wi, &ds.bin);
         }

@@ -670,5 +670,12 @@ const Extreme kMediumExtremes[] = {
 INSTANTIATE_TEST_SUITE_P(Vdb, VdbMediumExtremes, ::testing::ValuesIn(kMediumExtremes),
                          [](const auto& info) { return std::string(info.param.name); });
 
+// hemi guides no medium vertex: with mix=learn a medium vertex has no guide, and its direction
+// must not ask one for its pdf (a crash in session 41's first version of the BSDF-only path).
+TEST(HemiMedium, LearnedMixLeavesMediumVerticesUnguided) {
+    expectMean(renderText(foggyEnclosure(0.5, 0.8, 1.0), "hemi", {{"mix", "learn"}}), 1.0,
+               "hemi mix=learn thin, g 0.8");
+}
+
 }  // namespace
 }  // namespace rlpbrt
