@@ -192,8 +192,9 @@ private:
         ++stats.guidedVertices;
         if (clock) ++stats.timedGuidedVertices;
     }
-    // Whether a direction drawn at g needs the guide's pdf (a valid guide only): where it may be sampled, or
-    // where a selection sample rates the candidates (mix=learn, while the region learns).
+    // Whether a direction drawn at g needs the guide's pdf (a valid guide only): where it may
+    // be sampled, or where a selection sample rates the candidates (mix=learn, while the
+    // region learns).
     bool needsGuidePdf(GuideMixture& g) const {
         return g.guide.valid() && (guideMix(g) > 0.f || (g.recordsSelection && g.guide.learns()));
     }
