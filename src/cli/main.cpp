@@ -475,6 +475,7 @@ int main(int argc, char** argv) {
             if (guide == "vdb") j["guide_active_voxels"] = gs.activeVoxels;
             j["guide_learned_regions"] = gs.learnedRegions;
             j["guide_capped_regions"] = gs.cappedRegions;
+            j["guide_pruned_regions"] = gs.prunedRegions;
             j["guide_summary"] = field->describe();  // the guide's state after the render
             // Guiding's cost (render/guide_clock.h): the guide's time per vertex with a guide,
             // from the timed paths; the updates between passes; their share of the render's

@@ -64,6 +64,18 @@ void buildStrataCdf(const double* q, int n, double epsilon, float* cdf) {
     cdf[n] = 1.f;
 }
 
+double cosineSamplingVariance(const double* q, const StrataLayout& layout) {
+    double qc = 0.0, q2c = 0.0, cs = 0.0;
+    for (int j = 0; j < layout.count(); ++j) {
+        const double c = double(layout.centre(j).z);
+        qc += q[j] * c;
+        q2c += q[j] * q[j] * c;
+        cs += c;
+    }
+    const double v = q2c * cs / (qc * qc) - 1.0;
+    return qc > 0.0 && std::isfinite(v) ? std::max(v, 0.0) : 0.0;
+}
+
 namespace {
 
 // The piece of a CDF holding u: pieces i = 0..n-1 span [cdf[i * stride], cdf[(i + 1) * stride]);

@@ -162,6 +162,13 @@ private:
 // cdf[n] = 1 exactly; entries are non-decreasing. q must be finite and >= 0.
 void buildStrataCdf(const double* q, int n, double epsilon, float* cdf);
 
+// How far sampling by the cosine alone misses a hemisphere's learned light q (per stratum
+// of `layout`, finite and >= 0): the relative variance of the one-sample estimate of
+// sum_j q_j cos_j drawn with probabilities cos_j / sum cos, i.e.
+// sum q^2 cos x sum cos / (sum q cos)^2 - 1 (cos_j at the stratum centres): 0 for an even q,
+// large where q is concentrated; 0 where sum q cos is 0 or not finite.
+double cosineSamplingVariance(const double* q, const StrataLayout& layout);
+
 // Stratum selected by u in [0,1) on a CDF of n strata: the j with cdf[j] <= u < cdf[j+1]
 // (never a stratum of zero probability); clamped to n - 1 for u >= 1.
 int sampleStrataCdf(const float* cdf, int n, float u);

@@ -21,6 +21,8 @@ float GuidingField::confidence(int region) const { return region >= 0 ? 1.f : 0.
 
 bool GuidingField::learns(int) const { return true; }
 
+bool GuidingField::guides(int) const { return true; }
+
 float GuidingField::selection(int) const { return -1.f; }
 
 float GuidingField::policyRadiance(int region, const glm::vec3& w, int bin) const {
@@ -202,6 +204,9 @@ int parseSharedParam(const char* backend, const std::string& key, const std::str
     } else if (key == "learn-cap") {
         if (!parseDouble(value, &d) || d < 0.0 || d > 1e9) return bad();
         p->learnCap = d;
+    } else if (key == "prune") {
+        if (!parseDouble(value, &d) || !(d >= 0.0) || d > 1e9) return bad();
+        p->prune = d;
     } else if (key == "max-mb") {
         if (!parseDouble(value, &d) || !(d > 0.0)) return bad();
         *maxMiB = d;

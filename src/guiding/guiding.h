@@ -49,6 +49,7 @@ struct GuidingStats {
     uint64_t activeVoxels = 0;      // vdb backend: active voxels of the grid (0 otherwise)
     uint64_t learnedRegions = 0;    // regions with tables of their own (hemi, vdb surfaces)
     uint64_t cappedRegions = 0;     // of those, regions that stopped learning (learn-cap)
+    uint64_t prunedRegions = 0;     // regions that sample the BSDF only (prune)
     uint64_t selectionRegions = 0;  // regions with a learned selection (mix=learn)
     double selectionMean = 0.0;     // their mean selection probability
 };
@@ -210,6 +211,11 @@ public:
     // so that the integrator can skip the training work of its vertices. Frozen between
     // passes like the policy. Default: true.
     virtual bool learns(int region) const;
+    // Whether the integrator samples directions from `region`'s guide at all: false where
+    // the field judges its learned light too even to gain over the BSDF (the vertex then
+    // takes the BSDF's sample alone and needs no guide pdf). Frozen between passes like the
+    // policy. Default: true.
+    virtual bool guides(int region) const;
 
     // The learned probability of choosing the guide over the BSDF (or phase function) at a
     // region, frozen per pass like the policy, or -1 where none has been learned (the
@@ -329,6 +335,8 @@ public:
     float confidence() const { return field_->confidence(region_); }
     // GuidingField::learns for the region.
     bool learns() const { return field_->learns(region_); }
+    // GuidingField::guides for the region.
+    bool guides() const { return field_->guides(region_); }
     // The learned probability of choosing the guide, or -1 where none is learned.
     float selection() const { return field_->selection(region_); }
     // GuidingField::choice for the region (none for an invalid guide).

@@ -472,6 +472,8 @@ void HemiField::updateRegion(int region, const double* q) {
     RegionFrame& rf = frames_[size_t(region)];
     rf.confidence = table_.confidence(size_t(region), params_.warmup);
     rf.learns = table_.belowCap(size_t(region), params_.learnCap);
+    rf.guides = !(params_.prune > 0.0 && !trees_ && rf.confidence > 0.f &&
+                  cosineSamplingVariance(q, layout_) <= params_.prune);
     // buildPolicy's normalisation: p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n, or 1 / n
     // where the sum is not positive and finite (then Q_j = 0 for all j).
     double sum = 0.0;
@@ -640,6 +642,7 @@ GuidingStats HemiField::stats() const {
     GuidingStats s = trees_ ? trees_->stats() : table_.stats();
     s.learnedRegions = learnedRegions();
     for (const RegionFrame& f : frames_) s.cappedRegions += f.learns ? 0 : 1;
+    for (int r = 0; r < numRegions(); ++r) s.prunedRegions += guides(r) ? 0 : 1;
     return s;
 }
 

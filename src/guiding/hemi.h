@@ -50,6 +50,12 @@ struct HemiParams {
     // never): its guide stays as learned and its vertices skip the training work, which was
     // most of the guide's cost in long renders of scenes it cannot improve (docs/GUIDING.md).
     double learnCap = 256.0;
+    // A learned region samples only the BSDF (no guide, no guide pdf) where the cosine
+    // sampling of its learned light already has a relative variance (the second moment of
+    // Q cos / cos-pdf over its mean squared, minus 1) of at most prune: there the guide has
+    // little to gain and costs its work per vertex. 0: never; regions with spot lobes never,
+    // nor with treeDirections.
+    double prune = 0.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree
@@ -151,6 +157,10 @@ public:
     float confidence(int region) const override;
     bool learns(int region) const override {
         return validRegion(region) && frames_[size_t(region)].learns;
+    }
+    bool guides(int region) const override {
+        return validRegion(region) &&
+               (frames_[size_t(region)].guides || (spots_ && spots_->share(region) > 0.f));
     }
     float selection(int region) const override;
     void recordSelection(int slot, int region, const SelectionSample& s) override;
@@ -317,6 +327,7 @@ private:
         float confidence = 0.f;   // visits / (visits + warmup * strata), frozen per pass
         float policyScale = 0.f;  // sum_j Q_j cos_j / (1 - epsilon); 0 for a uniform CDF
         bool learns = true;       // below the learn cap (HemiParams::learnCap), frozen per pass
+        bool guides = true;       // not pruned (HemiParams::prune), frozen per pass
     };
     std::vector<RegionFrame> frames_;
     // Per stratum, 1 / the cosine factor of the policy (1 without the cosine product), and

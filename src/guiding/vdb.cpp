@@ -252,12 +252,21 @@ StrataTable::PolicyBuilder VdbField::policy() const {
         if (region < 0 || size_t(region) >= confidence_.size()) return;
         confidence_[size_t(region)] = table_.confidence(size_t(region), params_.warmup);
         learns_[size_t(region)] = table_.belowCap(size_t(region), params_.learnCap);
+        guides_[size_t(region)] =
+            !(params_.prune > 0.0 && !params_.sphere && confidence_[size_t(region)] > 0.f &&
+              cosineSamplingVariance(q, layout_) <= params_.prune);
     };
 }
 
 void VdbField::resetConfidence() {
     confidence_.assign(table_.regions(), params_.warmup > 0.0 ? 0.f : 1.f);
     learns_.assign(table_.regions(), 1);
+    guides_.assign(table_.regions(), 1);
+}
+
+bool VdbField::guides(int region) const {
+    if (volumeCell(region) >= 0) return true;  // medium cells: never pruned
+    return region >= 0 && size_t(region) < guides_.size() && guides_[size_t(region)] != 0;
 }
 
 bool VdbField::learns(int region) const {
@@ -499,7 +508,7 @@ size_t VdbField::bytes() const {
     return table_.bytes() + gridBytes() + clusterNormals_.capacity() * sizeof(glm::vec3) +
            clusterStart_.capacity() * sizeof(uint32_t) + regionVoxel_.capacity() * sizeof(int) +
            frames_.capacity() * sizeof(Frame) + confidence_.capacity() * sizeof(float) +
-           learns_.capacity() +
+           learns_.capacity() + guides_.capacity() +
            3 * centreX_.capacity() * sizeof(float) + (volume_ ? volume_->bytes() : 0);
 }
 
@@ -539,6 +548,7 @@ GuidingStats VdbField::stats() const {
     s.activeVoxels = activeVoxels();
     s.learnedRegions = table_.learnedRegions();
     for (uint8_t l : learns_) s.cappedRegions += l ? 0 : 1;
+    for (uint8_t g : guides_) s.prunedRegions += g ? 0 : 1;
     if (volume_) {
         const GuidingStats& v = volume_->stats();
         s.records += v.records;

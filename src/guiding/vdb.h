@@ -37,6 +37,7 @@ struct VdbParams {
     double normalAngleDeg = 30;  // normal clustering angle and lookup's admissible deviation
     double warmup = 8.0;      // confidence = visits / (visits + warmup * strata), as hemi
     double learnCap = 256.0;  // records per stratum after which a region stops, as hemi
+    double prune = 0.0;       // hemisphere tables: as hemi's (HemiParams::prune)
     // Hierarchical smoothing of the strata estimates, as hemi's (HemiParams::smooth), for the
     // surface and the volume tables: it removes samples=sequence's bias on a white furnace
     // (docs/STABILITY.md).
@@ -85,6 +86,7 @@ public:
     float radiance(int region, const glm::vec3& w, int bin = -1) const override;
     float confidence(int region) const override;
     bool learns(int region) const override;
+    bool guides(int region) const override;
     float selection(int region) const override;
     void recordSelection(int slot, int region, const SelectionSample& s) override;
     void beginPass(int numSlots) override;
@@ -191,6 +193,7 @@ private:
     // policy builder is const, called concurrently for distinct regions).
     mutable std::vector<float> confidence_;
     mutable std::vector<uint8_t> learns_;  // per surface region: below the learn cap
+    mutable std::vector<uint8_t> guides_;  // per surface region: not pruned (prune)
     void resetConfidence();
     std::vector<float> centreX_, centreY_, centreZ_;  // local stratum centres (all strata)
     StrataTable table_;

@@ -171,7 +171,7 @@ private:
             if (g.guide.valid()) {
                 g.confidence = g.guide.confidence();
                 g.scale = g.confidence * g.share;
-                g.mix = guideSelection(g.guide) * g.scale;
+                if (g.guide.guides()) g.mix = guideSelection(g.guide) * g.scale;
             }
         }
         return g.mix;

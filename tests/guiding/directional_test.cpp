@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <utility>
@@ -103,6 +104,46 @@ TEST(StrataLayout, StrataHaveEqualSolidAngle) {
     expected.back() = 0.5 * n;  // lower hemisphere
     chi2::Result r = chi2::testCounts(observed, expected);
     EXPECT_TRUE(r.passed) << r.message;
+}
+
+// cosineSamplingVariance: 0 for an even light (and where there is none), for one lit stratum
+// k sum cos / cos_k - 1 (the estimate is q_k sum cos with probability cos_k / sum cos); a
+// Monte Carlo run of that estimator agrees for a random light.
+TEST(CosineSamplingVariance, EvenOneHotAndMonteCarlo) {
+    const StrataLayout layout(8, 8);
+    const int n = layout.count();
+    std::vector<double> q(size_t(n), 2.5);
+    EXPECT_NEAR(cosineSamplingVariance(q.data(), layout), 0.0, 1e-12);
+    std::fill(q.begin(), q.end(), 0.0);
+    EXPECT_EQ(cosineSamplingVariance(q.data(), layout), 0.0);
+    double cs = 0.0;
+    for (int j = 0; j < n; ++j) cs += layout.centre(j).z;
+    q[17] = 3.0;
+    EXPECT_NEAR(cosineSamplingVariance(q.data(), layout), cs / layout.centre(17).z - 1.0, 1e-9);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    for (double& v : q) v = uni(rng) * uni(rng) * 10.0;
+    std::vector<double> cdf(size_t(n) + 1, 0.0);
+    double mean = 0.0;
+    for (int j = 0; j < n; ++j) {
+        cdf[size_t(j) + 1] = cdf[size_t(j)] + layout.centre(j).z / cs;
+        mean += q[size_t(j)] * layout.centre(j).z;
+    }
+    // The estimate's second moment, and 5 standard errors of it, from the samples.
+    double m2 = 0.0, m4 = 0.0;
+    const int samples = 1000000;
+    for (int i = 0; i < samples; ++i) {
+        const double u = uni(rng) * cdf[size_t(n)];
+        const auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
+        const int j = std::min(int(it - cdf.begin()) - 1, n - 1);
+        const double est = q[size_t(j)] * cs;  // q_j cos_j / (cos_j / cs)
+        m2 += est * est;
+        m4 += est * est * est * est;
+    }
+    m2 /= samples;
+    m4 /= samples;
+    const double se = std::sqrt((m4 - m2 * m2) / samples) / (mean * mean);
+    EXPECT_NEAR(cosineSamplingVariance(q.data(), layout), m2 / (mean * mean) - 1.0, 5.0 * se);
 }
 
 TEST(StrataCdf, UniformForZeroOrNonFiniteSums) {

@@ -532,6 +532,72 @@ TEST(HemiField, RegionStopsLearningAtTheCap) {
     EXPECT_EQ(g->stats().cappedRegions, 0u);
 }
 
+// prune: a learned region whose cosine sampling of its learned light has a relative variance
+// (sum Q^2 cos x sum cos / (sum Q cos)^2 - 1 over the strata) of at most prune samples the
+// BSDF alone (guides() false), from the pass whose learning shows it; 0 never prunes, an
+// untrained region (confidence 0) is never pruned, a concentrated light keeps its guide.
+TEST(HemiField, PruneLeavesEvenRegionsToTheBsdf) {
+    EXPECT_EQ(makeHemi(planeScene())->params().prune, 0.0);
+    // Strata 0 .. n-1 with Q 1, except stratum k with Q 1 + a.
+    const int k = 37;
+    const double a = 3.0;
+    auto train = [&](HemiField& f, int r) {
+        f.beginPass(1);
+        for (int j = 0; j < f.layout().count(); ++j)
+            f.record(0, r, strataCentre(f, r, j), j == k ? float(1.0 + a) : 1.f);
+        f.endPass();
+    };
+    auto expectedVariance = [&](const HemiField& f) {
+        double qc = 0.0, q2c = 0.0, cs = 0.0;
+        for (int j = 0; j < f.layout().count(); ++j) {
+            const double c = f.layout().centre(j).z, q = j == k ? 1.0 + a : 1.0;
+            qc += q * c;
+            q2c += q * q * c;
+            cs += c;
+        }
+        return q2c * cs / (qc * qc) - 1.0;
+    };
+    const int r = 0, even = 2, untrained = 4;
+    double v = 0.0;
+    {
+        auto f = makeHemi(planeScene(), {{"smooth", "0"}});
+        v = expectedVariance(*f);
+    }
+    ASSERT_GT(v, 0.01);
+    for (double prune : {0.0, 0.999 * v, 1.001 * v}) {
+        SCOPED_TRACE(prune);
+        auto f = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", std::to_string(prune)}});
+        ASSERT_TRUE(f);
+        EXPECT_EQ(f->params().prune, std::stod(std::to_string(prune)));
+        EXPECT_TRUE(f->guides(r));  // before any learning
+        train(*f, r);
+        // An even light (Q 1 everywhere): variance 0.
+        f->beginPass(1);
+        for (int j = 0; j < f->layout().count(); ++j)
+            f->record(0, even, strataCentre(*f, even, j), 1.f);
+        f->endPass();
+        const bool pruned = prune > v;
+        EXPECT_EQ(f->guides(r), !pruned);
+        EXPECT_EQ(f->guides(even), prune == 0.0);
+        EXPECT_TRUE(f->guides(untrained));
+        EXPECT_FALSE(f->guides(-1));
+        EXPECT_EQ(f->stats().prunedRegions, uint64_t(pruned) + uint64_t(prune > 0.0));
+        // Pruning leaves the policy and the learning as they are: the learned region's
+        // pdf still follows its light, and it still learns (records count).
+        EXPECT_GT(f->pdf(r, strataCentre(*f, r, k)), f->pdf(r, strataCentre(*f, r, k + 1)));
+        EXPECT_TRUE(f->learns(r));
+        // A light found later (one stratum far brighter) brings the guide back.
+        f->beginPass(1);
+        for (int i = 0; i < 64; ++i) f->record(0, r, strataCentre(*f, r, 5), 1000.f);
+        f->endPass();
+        EXPECT_TRUE(f->guides(r));
+    }
+    // A concentrated light is far above any sensible prune.
+    auto g = makeHemi(planeScene(), {{"points", "16"}, {"prune", "1"}});
+    trainBright(*g, 4, glm::normalize(glm::vec3(0.3f, -0.2f, 1.f)), 1, 5);
+    EXPECT_TRUE(g->guides(4));
+}
+
 TEST(HemiField, TrainedSamplingMatchesPdfAndFollowsLight) {
     auto f = makeHemi(planeScene(), {{"points", "16"}});
     ASSERT_TRUE(f);

@@ -271,6 +271,30 @@ TEST(HemiSpots, CorruptLobeBytesAreRefused) {
 // field's strata count) and carrying at least 1% of their region's learned light. A wide
 // cluster of candidates and a faint narrow one give no active lobe (share 0, density 0); the
 // same narrow cluster against a small region total does.
+// prune never leaves a region with spot lobes to the BSDF: its strata may be even (a small
+// lamp is far below a stratum's resolution) while the lobes are what its guide is for.
+TEST(HemiSpots, RegionWithLobesIsNeverPruned) {
+    for (bool spots : {false, true}) {
+        SCOPED_TRACE(spots);
+        auto f = makeHemi(
+            {{"points", "16"}, {"spots", spots ? "2" : "0"}, {"prune", "0.5"}, {"warmup", "0"}});
+        ASSERT_TRUE(f);
+        const int region = 4;
+        const glm::vec3 n = f->regionNormal(region);
+        const Frame frame = Frame::fromZ(n);
+        f->beginPass(1);
+        for (int j = 0; j < f->layout().count(); ++j)
+            f->record(0, region, frame.toWorld(f->layout().centre(j)), 1.f);
+        f->endPass();
+        EXPECT_FALSE(f->guides(region));
+        if (!spots) continue;
+        const glm::vec3 xc = f->regionPosition(region);
+        trainSpot(*f, region, xc, xc + glm::vec3(0.6f, -0.3f, 0.5f), 0.02f, 1e4f, 2, 5);
+        ASSERT_GT(f->spots()->share(region), 0.f);
+        EXPECT_TRUE(f->guides(region));
+    }
+}
+
 TEST(SpotLobes, WideOrFaintLobesDoNotSample) {
     SpotSettings ss;
     ss.perRegion = 2;

@@ -404,6 +404,34 @@ TEST(VdbField, RegionStopsLearningAtTheCap) {
     EXPECT_GE(f->selection(1), 0.f);
 }
 
+// prune as hemi's (HemiField.PruneLeavesEvenRegionsToTheBsdf): a surface region whose
+// learned light is even samples the BSDF alone; a concentrated one keeps its guide; never
+// with full-sphere tables, nor with prune 0.
+TEST(VdbField, PruneLeavesEvenRegionsToTheBsdf) {
+    for (const char* prune : {"0", "0.5"}) {
+        for (const char* dirs : {"hemi", "sphere"}) {
+            SCOPED_TRACE(std::string(prune) + " " + dirs);
+            auto f = makeVdb(planeScene(),
+                             {{"voxel", "4"}, {"strata", "4"}, {"prune", prune}, {"dirs", dirs}});
+            ASSERT_TRUE(f);
+            std::mt19937_64 rng(3);
+            f->beginPass(1);
+            for (int i = 0; i < 4096; ++i) {
+                const glm::vec3 w = test::gaussianDirection(rng);
+                f->record(0, 0, w, 1.f);
+                const float c = glm::dot(w, f->regionFrame(1).n);
+                f->record(0, 1, w, c > 0.9f ? 100.f : 1.f);
+            }
+            f->endPass();
+            const bool pruned = std::string(prune) != "0" && std::string(dirs) == "hemi";
+            EXPECT_EQ(f->guides(0), !pruned);
+            EXPECT_TRUE(f->guides(1));
+            EXPECT_EQ(f->stats().prunedRegions, uint64_t(pruned));
+            EXPECT_FALSE(f->guides(-1));
+        }
+    }
+}
+
 TEST(VdbField, RunningMeanAndEstimates) {
     auto f = makeVdb(planeScene(), {{"voxel", "4"}});
     ASSERT_TRUE(f);

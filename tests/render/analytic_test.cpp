@@ -570,6 +570,8 @@ const Extreme kExtremes[] = {
     {"spots_share_1", {{"spots", "1"}, {"spot-share", "1"}, {"warmup", "0"}}},
     {"split_64_window_tiny", {{"split", "64"}, {"split-window", "1e-6"}, {"warmup", "0"}}},
     {"split_2", {{"split", "2"}}},
+    {"prune_1e9", {{"prune", "1e9"}, {"warmup", "0"}}},
+    {"prune_1e_9", {{"prune", "1e-9"}, {"warmup", "0"}}},
 };
 
 INSTANTIATE_TEST_SUITE_P(Hemi, GuideExtremes, ::testing::ValuesIn(kExtremes),
