@@ -76,6 +76,11 @@ double cosineSamplingVariance(const double* q, const StrataLayout& layout) {
     return qc > 0.0 && std::isfinite(v) ? std::max(v, 0.0) : 0.0;
 }
 
+bool cosineSamplingSuffices(const double* q, const StrataLayout& layout, double prune,
+                            float confidence) {
+    return prune > 0.0 && confidence > 0.f && cosineSamplingVariance(q, layout) <= prune;
+}
+
 namespace {
 
 // The piece of a CDF holding u: pieces i = 0..n-1 span [cdf[i * stride], cdf[(i + 1) * stride]);

@@ -168,6 +168,11 @@ void buildStrataCdf(const double* q, int n, double epsilon, float* cdf);
 // sum q^2 cos x sum cos / (sum q cos)^2 - 1 (cos_j at the stratum centres): 0 for an even q,
 // large where q is concentrated; 0 where sum q cos is 0 or not finite.
 double cosineSamplingVariance(const double* q, const StrataLayout& layout);
+// The `prune` parameter's test for a hemisphere's table (hemi and vdb): pruning is on
+// (prune > 0), the table has learned something (confidence > 0) and its light q is even
+// enough for cosine sampling (cosineSamplingVariance <= prune).
+bool cosineSamplingSuffices(const double* q, const StrataLayout& layout, double prune,
+                            float confidence);
 
 // Stratum selected by u in [0,1) on a CDF of n strata: the j with cdf[j] <= u < cdf[j+1]
 // (never a stratum of zero probability); clamped to n - 1 for u >= 1.

@@ -472,8 +472,7 @@ void HemiField::updateRegion(int region, const double* q) {
     RegionFrame& rf = frames_[size_t(region)];
     rf.confidence = table_.confidence(size_t(region), params_.warmup);
     rf.learns = table_.belowCap(size_t(region), params_.learnCap);
-    rf.guides = !(params_.prune > 0.0 && !trees_ && rf.confidence > 0.f &&
-                  cosineSamplingVariance(q, layout_) <= params_.prune);
+    rf.guides = trees_ || !cosineSamplingSuffices(q, layout_, params_.prune, rf.confidence);
     // buildPolicy's normalisation: p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n, or 1 / n
     // where the sum is not positive and finite (then Q_j = 0 for all j).
     double sum = 0.0;

@@ -253,8 +253,8 @@ StrataTable::PolicyBuilder VdbField::policy() const {
         confidence_[size_t(region)] = table_.confidence(size_t(region), params_.warmup);
         learns_[size_t(region)] = table_.belowCap(size_t(region), params_.learnCap);
         guides_[size_t(region)] =
-            !(params_.prune > 0.0 && !params_.sphere && confidence_[size_t(region)] > 0.f &&
-              cosineSamplingVariance(q, layout_) <= params_.prune);
+            params_.sphere ||
+            !cosineSamplingSuffices(q, layout_, params_.prune, confidence_[size_t(region)]);
     };
 }
 

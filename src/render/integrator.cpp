@@ -219,7 +219,7 @@ DirectionSample PathIntegrator::sampleDirection(const SurfaceInteraction& si, co
     // Where the guide's probability is 0 (a region whose learned selection is 0, or not yet
     // confident), the BSDF's sample alone, without the guide's pdf unless a selection sample
     // needs it.
-    if (!guide.guide.valid() || !needsGuidePdf(guide)) {
+    if (!needsGuidePdf(guide)) {
         BSDFSample bs = bsdf.sampleF(si.wo, uc, u);
         if (!bs.valid()) return ds;
         ds.f = bs.f;
