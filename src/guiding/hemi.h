@@ -54,8 +54,10 @@ struct HemiParams {
     // sampling of its learned light already has a relative variance (the second moment of
     // Q cos / cos-pdf over its mean squared, minus 1) of at most prune: there the guide has
     // little to gain and costs its work per vertex. 0: never; regions with spot lobes never,
-    // nor with treeDirections.
-    double prune = 0.0;
+    // nor with treeDirections. The default 0.3 since session 43 (docs/GUIDING.md, `prune`):
+    // error x time per sample 0.93x on buddha-fractal and 0.96x on metal-spheres, equal on
+    // caustic-glass at 256 spp but 1.03x at 1024 spp.
+    double prune = 0.3;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree

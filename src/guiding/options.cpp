@@ -61,7 +61,7 @@ const std::vector<GuideOption>& guideOptions() {
         {"learn-cap", O::kBoth, kField, "256", "a number in [0, 1e9]",
          "records per stratum (a region's mean) after which a region stops learning and "
          "keeps its guide (0: never)"},
-        {"prune", O::kBoth, kField, "0", "a number in [0, 1e9]",
+        {"prune", O::kBoth, kField, "hemi: 0.3; vdb: 0", "a number in [0, 1e9]",
          "a learned region (surfaces; hemi: without spot lobes) samples the BSDF alone where "
          "the cosine sampling of its learned light has at most this relative variance "
          "(0: never)"},
