@@ -37,7 +37,9 @@ struct VdbParams {
     double normalAngleDeg = 30;  // normal clustering angle and lookup's admissible deviation
     double warmup = 8.0;      // confidence = visits / (visits + warmup * strata), as hemi
     double learnCap = 256.0;  // records per stratum after which a region stops, as hemi
-    double prune = 0.0;       // hemisphere tables: as hemi's (HemiParams::prune); 0 by default (not measured with vdb)
+    // Hemisphere tables: as hemi's (HemiParams::prune), but 0 by default (hemi's 0.3 was
+    // measured with hemi only).
+    double prune = 0.0;
     // Hierarchical smoothing of the strata estimates, as hemi's (HemiParams::smooth), for the
     // surface and the volume tables: it removes samples=sequence's bias on a white furnace
     // (docs/STABILITY.md).
