@@ -253,6 +253,11 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (!parseUnsigned(value, uint64_t(DirTree::kMaxDepth), &u) || u < 1)
                 return badValue("hemi", key, value, error);
             hp->treeDepth = int(u);
+        } else if (key == "judge") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || !(d >= 0.0) || d > 1.0)
+                return badValue("hemi", key, value, error);
+            hp->judge = d;
         } else if (key == "spots") {
             if (!parseUnsigned(value, 16, &u)) return badValue("hemi", key, value, error);
             hp->spots = int(u);

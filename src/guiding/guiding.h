@@ -216,6 +216,10 @@ public:
     // takes the BSDF's sample alone and needs no guide pdf). Frozen between passes like the
     // policy. Default: true.
     virtual bool guides(int region) const;
+    // Whether the field may still change a path: false where no region guides, learns or
+    // chooses anything any more (the integrator then skips the field: plain path tracing).
+    // Frozen between passes like the policy. Default: true.
+    virtual bool active() const { return true; }
 
     // The learned probability of choosing the guide over the BSDF (or phase function) at a
     // region, frozen per pass like the policy, or -1 where none has been learned (the

@@ -329,7 +329,8 @@ glm::vec3 HemiField::sampleAt(int region, const glm::vec3& x, glm::vec2 u, float
 
 void HemiField::recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
                            const glm::vec3& hit, float light, int bin) {
-    if (!spots_ || !validRegion(region)) return;  // (spots exclude directions=tree)
+    // (spots exclude directions=tree)
+    if (!spots_ || directionsOff_ || !validRegion(region)) return;
     if (!frames_[size_t(region)].learns) return;
     // Only where the strata have learned enough to tell a spot from their estimate.
     if (frames_[size_t(region)].confidence < 0.5f) return;
@@ -387,8 +388,7 @@ float HemiField::selection(int region) const {
 
 void HemiField::recordSelection(int slot, int region, const SelectionSample& s) {
     // A region that stopped learning (learn-cap) keeps its selection as well.
-    if (validRegion(region) && frames_[size_t(region)].learns)
-        table_.selection().record(slot, region, s);
+    if (learns(region)) table_.selection().record(slot, region, s);
 }
 
 float HemiField::radiance(int region, const glm::vec3& w, int bin) const {
@@ -450,6 +450,7 @@ void HemiField::beginPass(int numSlots) {
 }
 
 void HemiField::record(int slot, int region, const glm::vec3& w, float target, int bin) {
+    if (directionsOff_) return;
     if (trees_) {
         glm::vec2 a(-1.f);  // outside the square: counted as rejected
         treePoint(region, w, &a);
@@ -520,6 +521,53 @@ void HemiField::endPass() {
         trees_->endPass();
         updateTreeRegions();
     }
+    judgeDirections();
+}
+
+double HemiField::directionGuidingRatio(double* confidence) const {
+    std::vector<double> q(static_cast<size_t>(strata_));
+    double visits = 0.0, conf = 0.0, cosine = 0.0, mixture = 0.0;
+    const double n = double(strata_), eps = params_.epsilon;
+    for (int r = 0; r < numRegions(); ++r) {
+        const double v = table_.visitsTotal(size_t(r));
+        if (!(v > 0.0)) continue;
+        table_.estimate(size_t(r), q.data());
+        double qc = 0.0, cs = 0.0;
+        for (int j = 0; j < strata_; ++j) {
+            const double c = double(layout_.centre(j).z);
+            qc += q[size_t(j)] * c;
+            cs += c;
+        }
+        if (!(qc > 0.0) || !std::isfinite(qc)) continue;
+        const RegionFrame& f = frames_[size_t(r)];
+        // The guide's share in the mixture, as the integrator's default mix 0.5 times the
+        // confidence; its CDF p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n.
+        const double mix = f.guides ? 0.5 * double(f.confidence) : 0.0;
+        double sc = 0.0, sm = 0.0;
+        for (int j = 0; j < strata_; ++j) {
+            const double c = double(layout_.centre(j).z), x = q[size_t(j)] * c;
+            if (!(x > 0.0)) continue;
+            const double pc = c / cs, pg = (1.0 - eps) * x / qc + eps / n;
+            sc += x * x / pc;
+            sm += x * x / ((1.0 - mix) * pc + mix * pg);
+        }
+        const double s = spots_ ? double(spots_->share(r)) : 0.0;
+        if (s > 0.0) sm = std::min(sm, (1.0 - s) * sc);
+        const double norm = 1.0 / (qc * qc);
+        visits += v;
+        conf += v * double(f.confidence);
+        cosine += v * sc * norm;
+        mixture += v * sm * norm;
+    }
+    *confidence = visits > 0.0 ? conf / visits : 0.0;
+    return cosine > 0.0 && std::isfinite(mixture / cosine) ? mixture / cosine : 1.0;
+}
+
+void HemiField::judgeDirections() {
+    if (!(params_.judge > 0.0) || directionsOff_ || trees_) return;
+    double confidence = 0.0;
+    const double ratio = directionGuidingRatio(&confidence);
+    if (confidence >= 0.5 && ratio > params_.judge) directionsOff_ = true;
 }
 
 void HemiField::updateTreeRegions() {
@@ -557,6 +605,7 @@ void HemiField::endPassShared(const SumAcrossProcesses& sum) {
             throw std::runtime_error("hemi: the ranks' spot candidates are corrupt");
         spots_->endPass(learnedTotals());
     }
+    judgeDirections();
 }
 
 size_t HemiField::bytes() const {
@@ -626,6 +675,15 @@ std::string HemiField::describe() const {
     }
     if (numPatches_ > 0) {
         std::snprintf(buf, sizeof(buf), "; %u surface patches", numPatches_);
+        line += buf;
+    }
+    if (params_.judge > 0.0 && !trees_) {
+        double confidence = 0.0;
+        const double ratio = directionGuidingRatio(&confidence);
+        std::snprintf(buf, sizeof(buf), "; judge %g: predicted second moment %.3f of cosine "
+                      "sampling's at confidence %.2f, %s", params_.judge, ratio, confidence,
+                      directionsOff_ ? (active() ? "directions off" : "field off")
+                                     : "guiding");
         line += buf;
     }
     const SelectionLearner& sel = table_.selection();
@@ -812,6 +870,10 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
         }
     }
     if (spots_) spots_->refitAll(learnedTotals());
+    // The verdict of the tables loaded (a field saved after its verdict stopped learning
+    // there, so it reaches the same one).
+    directionsOff_ = false;
+    judgeDirections();
     return true;
 }
 

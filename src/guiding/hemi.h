@@ -58,6 +58,15 @@ struct HemiParams {
     // error x time per sample 0.93x on buddha-fractal and 0.96x on metal-spheres, equal on
     // caustic-glass at 256 spp but 1.03x at 1024 spp.
     double prune = 0.3;
+    // The scene's verdict on direction guiding (0: none): once the learned regions'
+    // visit-weighted confidence reaches 0.5, the second moment of the strata's light under
+    // the guide's mixture is predicted against cosine sampling's (visit-weighted over the
+    // regions, as directionGuidingPays() computes); where the mixture keeps more than judge of
+    // it, every region stops guiding and learning directions for good (the verdict is a
+    // function of the tables, which then stop changing, so a saved or shared field reaches
+    // it again). A field without a learned light choice then changes no path: the
+    // integrator skips it (GuidingField::active).
+    double judge = 0.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree
@@ -137,7 +146,7 @@ public:
                 int* bin = nullptr) const override;
     void recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
                     const glm::vec3& hit, float light, int bin = -1) override;
-    bool learnsSpots() const override { return spots_ != nullptr; }
+    bool learnsSpots() const override { return spots_ != nullptr && !directionsOff_; }
     bool enableChoices(int n) override;
     Choice choice(int region) const override {
         if (!choices_ || !validRegion(region)) return Choice();
@@ -157,11 +166,23 @@ public:
     // total divided by cos_j. (radiance() with epsilon = 1, where the CDF holds no Q.)
     float policyRadiance(int region, const glm::vec3& w, int bin = -1) const override;
     float confidence(int region) const override;
+    // False once the judge (HemiParams::judge) stopped direction guiding in a field without
+    // a learned light choice: no region then guides, learns or chooses.
+    bool active() const override { return !(directionsOff_ && !choices_); }
+    // Whether the judge stopped direction guiding (every region samples the BSDF alone and
+    // learns no directions).
+    bool directionsOff() const { return directionsOff_; }
+    // The judge's prediction from the tables as they are: the visit-weighted second moment
+    // of the strata's learned light under the guide's mixture (mix 0.5 x confidence where a
+    // region guides; a region with spot lobes of share s at most 1 - s of its cosine
+    // sampling's) over cosine sampling's; *confidence: the regions' visit-weighted
+    // confidence. 1 (and 0) without visits.
+    double directionGuidingRatio(double* confidence) const;
     bool learns(int region) const override {
-        return validRegion(region) && frames_[size_t(region)].learns;
+        return !directionsOff_ && validRegion(region) && frames_[size_t(region)].learns;
     }
     bool guides(int region) const override {
-        return validRegion(region) &&
+        return !directionsOff_ && validRegion(region) &&
                (frames_[size_t(region)].guides || (spots_ && spots_->share(region) > 0.f));
     }
     float selection(int region) const override;
@@ -312,6 +333,10 @@ private:
     std::unique_ptr<uint32_t[], FreeDeleter> patchPoint_;
     uint32_t numPatches_ = 0;
     std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> patchCentre_;
+    // The judge's verdict (HemiParams::judge): direction guiding stopped for good.
+    bool directionsOff_ = false;
+    // Judges once the regions' confidence suffices (endPass, endPassShared, loads).
+    void judgeDirections();
     // The memo entry of a patch (kNoPoint if none admissible).
     uint32_t fillPatch(uint32_t patch) const;
     // Of a point's two hemispheres (n, -n), the region on n's side if the point's normal is

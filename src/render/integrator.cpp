@@ -432,7 +432,7 @@ PathIntegrator::Step PathIntegrator::mediumStep(PathState& s, bool found,
     if (bounces >= maxDepth_) return Step::End;
     const Vec3 p = s.ray.o + ms.t * s.ray.d, wo = -s.ray.d;
     guiding::VertexGuide guide;
-    const bool guided = guide_.field && guide_.field->guidesMedia();
+    const bool guided = guide_.field && guide_.field->active() && guide_.field->guidesMedia();
     if (guided) {
         GuideTimer timer(s.clock);
         guide = guide_.field->guide(guiding::VertexQuery::inMedium(p));
@@ -534,7 +534,9 @@ Spectrum PathIntegrator::Li(const Ray& cameraRay, Sampler& sampler, PathStats& s
     s.ray = cameraRay;
     int passThroughs = 0;
     BSDF bsdf;
-    guiding::GuidingField* field = guide_.field;
+    // A field that can no longer change a path (GuidingField::active) is skipped: plain path
+    // tracing, its recorder off too.
+    guiding::GuidingField* field = guide_.field && guide_.field->active() ? guide_.field : nullptr;
     PathRecorder rec(guide_, slot);
     // One path in kGuideClockEvery measures the guide's time (render/guide_clock.h).
     s.clock = field && stats.paths % kGuideClockEvery == 0 ? &stats.guideClock : nullptr;

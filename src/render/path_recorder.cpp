@@ -9,7 +9,7 @@
 namespace rlpbrt {
 
 PathRecorder::PathRecorder(const GuideSettings& guide, int slot)
-    : learn_(guide.field && guide.learn),
+    : learn_(guide.field && guide.learn && guide.field->active()),
       learnSelection_(learn_ && guide.learnMix),
       // Training targets of surface vertices: the path's returns, or Eq. 1 bootstrapped at
       // the next vertex (pending). Medium vertices always bootstrap: in a lossless medium the

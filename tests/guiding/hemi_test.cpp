@@ -536,6 +536,79 @@ TEST(HemiField, RegionStopsLearningAtTheCap) {
 // (sum Q^2 cos x sum cos / (sum Q cos)^2 - 1 over the strata) of at most prune samples the
 // BSDF alone (guides() false), from the pass whose learning shows it; 0 never prunes, an
 // untrained region (confidence 0) is never pruned, a concentrated light keeps its guide.
+// judge: once the regions' visit-weighted confidence reaches 0.5, a field whose learned light
+// the guide's mixture would sample no better than cosine sampling (predicted second moment
+// above judge of cosine sampling's) stops guiding and learning directions for good, and,
+// without a learned light choice, is inactive (the integrator skips it). A concentrated light
+// keeps it; judge 0 (the default) never stops; a saved field reaches the same verdict.
+TEST(HemiField, JudgeStopsDirectionGuidingWhereItCannotGain) {
+    EXPECT_EQ(makeHemi(planeScene())->params().judge, 0.0);
+    auto trainEven = [](HemiField& f, int r, int passes) {
+        for (int p = 0; p < passes; ++p) {
+            f.beginPass(1);
+            for (int j = 0; j < f.layout().count(); ++j)
+                for (int i = 0; i < 16; ++i) f.record(0, r, strataCentre(f, r, j), 1.f);
+            f.endPass();
+        }
+    };
+    const int r = 2;
+    for (const char* judge : {"0", "0.9"}) {
+        SCOPED_TRACE(judge);
+        auto f = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", "0"}, {"judge", judge}});
+        ASSERT_TRUE(f);
+        double confidence = -1.0;
+        EXPECT_EQ(f->directionGuidingRatio(&confidence), 1.0);  // no visits yet
+        EXPECT_EQ(confidence, 0.0);
+        // 16 records per stratum: confidence 16 / (16 + warmup 8) = 2/3 after one pass.
+        trainEven(*f, r, 1);
+        const double ratio = f->directionGuidingRatio(&confidence);
+        EXPECT_NEAR(confidence, 2.0 / 3.0, 1e-6);
+        // Even light: the guide's CDF is cosine sampling mixed with epsilon's uniform share,
+        // slightly worse than cosine sampling alone.
+        EXPECT_GT(ratio, 1.0);
+        EXPECT_LT(ratio, 1.1);
+        const bool off = std::string(judge) != "0";
+        EXPECT_EQ(f->directionsOff(), off);
+        EXPECT_EQ(f->active(), !off);
+        EXPECT_EQ(f->guides(r), !off);
+        EXPECT_EQ(f->learns(r), !off);
+        EXPECT_EQ(f->learnsSpots(), !off);
+        // After the verdict nothing is learned any more (records are ignored).
+        const uint64_t records = f->stats().records;
+        trainEven(*f, r, 1);
+        EXPECT_EQ(f->stats().records == records, off);
+        if (!off) continue;
+        // A saved field reaches the verdict again on load; one without judge does not.
+        std::string state, error;
+        ASSERT_TRUE(f->saveState(&state, &error)) << error;
+        auto g = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", "0"}, {"judge", judge}});
+        ASSERT_TRUE(g->loadState(state, &error)) << error;
+        EXPECT_TRUE(g->directionsOff());
+        EXPECT_FALSE(g->active());
+        auto h = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", "0"}});
+        ASSERT_TRUE(h->loadState(state, &error)) << error;
+        EXPECT_FALSE(h->directionsOff());
+        EXPECT_TRUE(h->guides(r));
+    }
+    // A concentrated light: predicted far below cosine sampling, the guide stays.
+    auto f = makeHemi(planeScene(), {{"judge", "0.9"}});
+    trainBright(*f, 4, glm::normalize(glm::vec3(0.3f, -0.2f, 1.f)), 2, 5);
+    double confidence = 0.0;
+    EXPECT_LT(f->directionGuidingRatio(&confidence), 0.5);
+    EXPECT_GE(confidence, 0.5);
+    EXPECT_FALSE(f->directionsOff());
+    EXPECT_TRUE(f->active());
+    EXPECT_TRUE(f->guides(4));
+    // Not yet judged below confidence 0.5 (few records): an even light's field guides on.
+    auto young = makeHemi(planeScene(), {{"prune", "0"}, {"judge", "0.9"}});
+    young->beginPass(1);
+    for (int j = 0; j < young->layout().count(); ++j)
+        young->record(0, r, strataCentre(*young, r, j), 1.f);
+    young->endPass();
+    EXPECT_FALSE(young->directionsOff());
+    EXPECT_TRUE(young->guides(r));
+}
+
 TEST(HemiField, PruneLeavesEvenRegionsToTheBsdf) {
     EXPECT_EQ(makeHemi(planeScene())->params().prune, 0.3);  // the default (session 43)
     // Strata 0 .. n-1 with Q 1, except stratum k with Q 1 + a.
