@@ -65,8 +65,11 @@ struct HemiParams {
     // it, every region stops guiding and learning directions for good (the verdict is a
     // function of the tables, which then stop changing, so a saved or shared field reaches
     // it again). A field without a learned light choice then changes no path: the
-    // integrator skips it (GuidingField::active).
-    double judge = 0.0;
+    // integrator skips it (GuidingField::active). The default 0.8 since session 44
+    // (docs/GUIDING.md, `judge`): it stops directions on buddha-fractal, metal-spheres, cloud,
+    // caustic-glass and conference-room (predicted 0.86-1.0; per sample their direction
+    // guiding gains nothing) and on none of the scenes whose guide gains (0.08-0.70).
+    double judge = 0.8;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree

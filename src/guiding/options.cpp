@@ -87,7 +87,7 @@ const std::vector<GuideOption>& guideOptions() {
          "hemisphere's learned light"},
         {"tree-depth", O::kHemi, kField, "12", "an integer in 1..16",
          "directions=tree: the deepest level (leaf edge 2^-depth of the square)"},
-        {"judge", O::kHemi, kField, "0", "a number in [0, 1]",
+        {"judge", O::kHemi, kField, "0.8", "a number in [0, 1]",
          "once the regions' visit-weighted confidence reaches 0.5: if the guide's mixture "
          "would keep more than this share of cosine sampling's second moment, direction "
          "guiding stops for good (0: never)"},

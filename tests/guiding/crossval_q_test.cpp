@@ -48,9 +48,10 @@ struct Cell {
 // (each from its cell's sample variance and count).
 TEST(GuideCrossValidation, HemiAndVdbLearnTheSameQ) {
     // (smooth=0: radiance() is then Q itself, the running mean compared below; learn-cap=0:
-    // the mean of every record, however many a cell takes)
-    auto hemi = make("hemi",
-                     {{"points", "16"}, {"strata", "4x4"}, {"smooth", "0"}, {"learn-cap", "0"}});
+    // the mean of every record, however many a cell takes; judge=0: hemi's learning goes on
+    // where its guide would gain nothing)
+    auto hemi = make("hemi", {{"points", "16"}, {"strata", "4x4"}, {"smooth", "0"},
+                              {"learn-cap", "0"}, {"judge", "0"}});
     auto vdb = make("vdb",
                     {{"voxel", "4"}, {"strata", "4x4"}, {"smooth", "0"}, {"learn-cap", "0"}});
     ASSERT_TRUE(hemi && vdb);

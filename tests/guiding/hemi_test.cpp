@@ -482,7 +482,8 @@ TEST(HemiField, SmoothingSpreadsSparseVisitsAndKeepsThePdfExact) {
 // records, keeps its guide, and ignores its records; the others go on; 0 never stops.
 TEST(HemiField, RegionStopsLearningAtTheCap) {
     EXPECT_EQ(makeHemi(planeScene())->params().learnCap, 256.0);
-    auto f = makeHemi(planeScene(), {{"learn-cap", "2"}});  // 512 records of 256 strata
+    // (judge=0: these even lights would stop direction learning, HemiField.Judge...)
+    auto f = makeHemi(planeScene(), {{"learn-cap", "2"}, {"judge", "0"}});  // 512 records
     ASSERT_TRUE(f);
     const int r = 0;
     const glm::vec3 n = f->regionNormal(r);
@@ -523,7 +524,7 @@ TEST(HemiField, RegionStopsLearningAtTheCap) {
     EXPECT_EQ(f->selection(r), -1.f);
     EXPECT_GE(f->selection(r + 2), 0.f);
     // learn-cap 0: a region never stops.
-    auto g = makeHemi(planeScene(), {{"learn-cap", "0"}});
+    auto g = makeHemi(planeScene(), {{"learn-cap", "0"}, {"judge", "0"}});
     ASSERT_TRUE(g);
     g->beginPass(1);
     for (int i = 0; i < 100000; ++i) g->record(0, r, n, 1.f);
@@ -542,7 +543,7 @@ TEST(HemiField, RegionStopsLearningAtTheCap) {
 // without a learned light choice, is inactive (the integrator skips it). A concentrated light
 // keeps it; judge 0 (the default) never stops; a saved field reaches the same verdict.
 TEST(HemiField, JudgeStopsDirectionGuidingWhereItCannotGain) {
-    EXPECT_EQ(makeHemi(planeScene())->params().judge, 0.0);
+    EXPECT_EQ(makeHemi(planeScene())->params().judge, 0.8);  // the default (session 44)
     auto trainEven = [](HemiField& f, int r, int passes) {
         for (int p = 0; p < passes; ++p) {
             f.beginPass(1);
@@ -585,7 +586,7 @@ TEST(HemiField, JudgeStopsDirectionGuidingWhereItCannotGain) {
         ASSERT_TRUE(g->loadState(state, &error)) << error;
         EXPECT_TRUE(g->directionsOff());
         EXPECT_FALSE(g->active());
-        auto h = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", "0"}});
+        auto h = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", "0"}, {"judge", "0"}});
         ASSERT_TRUE(h->loadState(state, &error)) << error;
         EXPECT_FALSE(h->directionsOff());
         EXPECT_TRUE(h->guides(r));
@@ -743,7 +744,8 @@ TEST(HemiField, SampleReportsPdfOfItsDirection) {
 
 TEST(HemiField, RunningMeanConvergesToTargets) {
     auto f = makeHemi(planeScene(),
-                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}, {"smooth", "0"}});
+                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"},
+                       {"smooth", "0"}, {"judge", "0"}});
     ASSERT_TRUE(f);
     const int region = 2, n = f->layout().count();
     std::mt19937_64 rng(31);
@@ -769,7 +771,8 @@ TEST(HemiField, RunningMeanConvergesToTargets) {
     }
     // Noise-free constant targets: Q equals T exactly after one pass.
     auto g = makeHemi(planeScene(),
-                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"}, {"smooth", "0"}});
+                      {{"points", "4"}, {"strata", "4x2"}, {"epsilon", "0.1"}, {"cosine", "0"},
+                       {"smooth", "0"}, {"judge", "0"}});
     ASSERT_TRUE(g);
     g->beginPass(1);
     double total = 0.0;
@@ -902,7 +905,7 @@ TEST(HemiField, FixedAlphaFollowsGeometricSchedule) {
         {1.0, "1"}, {0.5, "0.5"}, {0.1, "0.1"}, {1e-9, "1e-9"}};
     for (const auto& [alpha, text] : alphas) {
         auto f = makeHemi(planeScene(), {{"points", "1"}, {"strata", "1x1"},
-                                         {"alpha", text}, {"init", "1"}});
+                                         {"alpha", text}, {"init", "1"}, {"judge", "0"}});
         ASSERT_TRUE(f);
         const glm::vec3 up(0, 0, 1);
         double expected = 1.0;

@@ -277,7 +277,8 @@ TEST(HemiSpots, RegionWithLobesIsNeverPruned) {
     for (bool spots : {false, true}) {
         SCOPED_TRACE(spots);
         auto f = makeHemi(
-            {{"points", "16"}, {"spots", spots ? "2" : "0"}, {"prune", "0.5"}, {"warmup", "0"}});
+            {{"points", "16"}, {"spots", spots ? "2" : "0"}, {"prune", "0.5"}, {"warmup", "0"},
+             {"judge", "0"}});
         ASSERT_TRUE(f);
         const int region = 4;
         const glm::vec3 n = f->regionNormal(region);
