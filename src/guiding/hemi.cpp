@@ -543,21 +543,23 @@ double HemiField::directionGuidingRatio(double* confidence) const {
         // The guide's share in the mixture, as the integrator's default mix 0.5 times the
         // confidence; its CDF p_j = (1 - epsilon) Q_j cos_j / sum + epsilon / n.
         const double mix = f.guides ? 0.5 * double(f.confidence) : 0.0;
-        double sc = 0.0, sm = 0.0;
+        // Second moments relative to (sum Q cos)^2: cosine sampling's is 1 + its relative
+        // variance (the `prune` test's), the mixture's is summed here.
+        const double sc = 1.0 + cosineSamplingVariance(q.data(), layout_);
+        double sm = 0.0;
         for (int j = 0; j < strata_; ++j) {
             const double c = double(layout_.centre(j).z), x = q[size_t(j)] * c;
             if (!(x > 0.0)) continue;
             const double pc = c / cs, pg = (1.0 - eps) * x / qc + eps / n;
-            sc += x * x / pc;
             sm += x * x / ((1.0 - mix) * pc + mix * pg);
         }
+        sm /= qc * qc;
         const double s = spots_ ? double(spots_->share(r)) : 0.0;
         if (s > 0.0) sm = std::min(sm, (1.0 - s) * sc);
-        const double norm = 1.0 / (qc * qc);
         visits += v;
         conf += v * double(f.confidence);
-        cosine += v * sc * norm;
-        mixture += v * sm * norm;
+        cosine += v * sc;
+        mixture += v * sm;
     }
     *confidence = visits > 0.0 ? conf / visits : 0.0;
     return cosine > 0.0 && std::isfinite(mixture / cosine) ? mixture / cosine : 1.0;
