@@ -258,6 +258,11 @@ bool parseHemiParams(const std::map<std::string, std::string>& params, HemiParam
             if (!parseDouble(value, &d) || !(d >= 0.0) || d > 1.0)
                 return badValue("hemi", key, value, error);
             hp->judge = d;
+        } else if (key == "spot-judge") {
+            double d = 0.0;
+            if (!parseDouble(value, &d) || !(d >= 0.0) || !std::isfinite(d))
+                return badValue("hemi", key, value, error);
+            hp->spotJudge = d;
         } else if (key == "spots") {
             if (!parseUnsigned(value, 16, &u)) return badValue("hemi", key, value, error);
             hp->spots = int(u);

@@ -521,7 +521,7 @@ void HemiField::endPass() {
         trees_->endPass();
         updateTreeRegions();
     }
-    judgeDirections();
+    judgeScene();
 }
 
 double HemiField::directionGuidingRatio(double* confidence) const {
@@ -565,11 +565,40 @@ double HemiField::directionGuidingRatio(double* confidence) const {
     return cosine > 0.0 && std::isfinite(mixture / cosine) ? mixture / cosine : 1.0;
 }
 
-void HemiField::judgeDirections() {
-    if (!(params_.judge > 0.0) || directionsOff_ || trees_) return;
+namespace {
+constexpr double kSpotJudgeConfidence = 0.8;
+}  // namespace
+
+double HemiField::spotWorth() const {
+    if (!spots_) return 0.0;
+    double visits = 0.0, worth = 0.0;
+    for (int r = 0; r < numRegions(); ++r) {
+        const double v = table_.visitsTotal(size_t(r));
+        if (!(v > 0.0)) continue;
+        visits += v;
+        worth += v * double(spots_->worth(r));
+    }
+    return visits > 0.0 ? worth / visits : 0.0;
+}
+
+void HemiField::judgeScene() {
+    if (directionsOff_ || trees_) return;
+    const bool directions = params_.judge > 0.0;
+    const bool spots = params_.spotJudge > 0.0 && spots_ && !spots_->silenced();
+    if (!directions && !spots) return;
     double confidence = 0.0;
     const double ratio = directionGuidingRatio(&confidence);
-    if (confidence >= 0.5 && ratio > params_.judge) directionsOff_ = true;
+    if (confidence < 0.5) return;
+    if (directions && ratio > params_.judge) directionsOff_ = true;
+    // Lobes sharpen and gain light share as they learn: their worth is judged later, at
+    // confidence 0.8 (session 45: at 0.5 glossy-lamps' lobes were worth 0.14, at 0.8 8.5).
+    if (spots && !directionsOff_ && confidence >= kSpotJudgeConfidence) {
+        const double worth = spotWorth();
+        if (worth < params_.spotJudge) {
+            spotWorthAtVerdict_ = worth;
+            spots_->setSilenced(true);
+        }
+    }
 }
 
 void HemiField::updateTreeRegions() {
@@ -607,7 +636,7 @@ void HemiField::endPassShared(const SumAcrossProcesses& sum) {
             throw std::runtime_error("hemi: the ranks' spot candidates are corrupt");
         spots_->endPass(learnedTotals());
     }
-    judgeDirections();
+    judgeScene();
 }
 
 size_t HemiField::bytes() const {
@@ -662,6 +691,12 @@ std::string HemiField::describe() const {
                       params_.spots, params_.spotShare, params_.spotOutlier,
                       spots_->activeLobes(), spots_->activeRegions());
         line += buf;
+        if (params_.spotJudge > 0.0 && !trees_) {
+            const bool off = spots_->silenced();
+            std::snprintf(buf, sizeof(buf), ", spot judge %g: worth %.3g, %s", params_.spotJudge,
+                          off ? spotWorthAtVerdict_ : spotWorth(), off ? "lobes off" : "lobes on");
+            line += buf;
+        }
     }
     if (choices_) {
         size_t used = 0, full = 0;
@@ -871,11 +906,14 @@ bool HemiField::loadBytes(const std::string& data, const std::string& name,
             updateChoiceWeights();
         }
     }
-    if (spots_) spots_->refitAll(learnedTotals());
+    if (spots_) {
+        spots_->setSilenced(false);
+        spots_->refitAll(learnedTotals());
+    }
     // The verdict of the tables loaded (a field saved after its verdict stopped learning
     // there, so it reaches the same one).
     directionsOff_ = false;
-    judgeDirections();
+    judgeScene();
     return true;
 }
 

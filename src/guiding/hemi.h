@@ -70,6 +70,17 @@ struct HemiParams {
     // caustic-glass and conference-room (predicted 0.86-1.0; per sample their direction
     // guiding gains nothing) and on none of the scenes whose guide gains (0.08-0.70).
     double judge = 0.8;
+    // The scene's verdict on spot lobes (0: none): once the regions' visit-weighted
+    // confidence reaches 0.8 (then after every pass until it fires), the
+    // visit-weighted mean over the regions of their lobes' worth (SpotLobes::worth: the
+    // lobes' light share x how many times narrower than a stratum they are); below
+    // spotJudge every region's lobes stop sampling and learning for good, sparing their
+    // density at every vertex (docs/GUIDING.md, `spot-judge`). The default 3 since session
+    // 45: at confidence 0.8 the lobes of veach-bidir, breakfast and glossy-lamps are worth
+    // 8.5-34 (they gain 1.1-1.6x per sample there) and those of killeroo, cornell-box and
+    // door 0.01-0.45 (at most 3% per sample); at 30 s against plain killeroo 1.15 -> 1.03,
+    // cornell-box 0.76 -> 0.70, door 0.21 -> 0.22.
+    double spotJudge = 3.0;
     // lookup=cell: the knn points nearest to the centre of the query's cell, from a memo
     // filled once per cell (guiding/cell_cache.h; cells as large as the points' mean
     // spacing), are checked for an admissible normal in that order. lookup=exact: the kd-tree
@@ -149,7 +160,9 @@ public:
                 int* bin = nullptr) const override;
     void recordSpot(int slot, int region, const glm::vec3& x, const glm::vec3& w,
                     const glm::vec3& hit, float light, int bin = -1) override;
-    bool learnsSpots() const override { return spots_ != nullptr && !directionsOff_; }
+    bool learnsSpots() const override {
+        return spots_ != nullptr && !spots_->silenced() && !directionsOff_;
+    }
     bool enableChoices(int n) override;
     Choice choice(int region) const override {
         if (!choices_ || !validRegion(region)) return Choice();
@@ -181,6 +194,9 @@ public:
     // sampling's) over cosine sampling's; *confidence: the regions' visit-weighted
     // confidence. 1 (and 0) without visits.
     double directionGuidingRatio(double* confidence) const;
+    // The spot verdict's measure (HemiParams::spotJudge): the visit-weighted mean of the
+    // regions' SpotLobes::worth (0 without spots or visits).
+    double spotWorth() const;
     bool learns(int region) const override {
         return !directionsOff_ && validRegion(region) && frames_[size_t(region)].learns;
     }
@@ -338,8 +354,11 @@ private:
     std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> patchCentre_;
     // The judge's verdict (HemiParams::judge): direction guiding stopped for good.
     bool directionsOff_ = false;
-    // Judges once the regions' confidence suffices (endPass, endPassShared, loads).
-    void judgeDirections();
+    // The spot verdict's worth (spotWorth() when it stopped the lobes), for describe().
+    double spotWorthAtVerdict_ = 0.0;
+    // Judges directions (judge) and spot lobes (spotJudge) once the regions' confidence
+    // suffices (endPass, endPassShared, loads).
+    void judgeScene();
     // The memo entry of a patch (kNoPoint if none admissible).
     uint32_t fillPatch(uint32_t patch) const;
     // Of a point's two hemispheres (n, -n), the region on n's side if the point's normal is

@@ -91,6 +91,10 @@ const std::vector<GuideOption>& guideOptions() {
          "once the regions' visit-weighted confidence reaches 0.5: if the guide's mixture "
          "would keep more than this share of cosine sampling's second moment, direction "
          "guiding stops for good (0: never)"},
+        {"spot-judge", O::kHemi, kField, "3", "a number >= 0",
+         "once the regions' visit-weighted confidence reaches 0.8: if their spot lobes' "
+         "visit-weighted worth (light share x how many times narrower than a stratum) is "
+         "below this, the lobes stop for good (0: never)"},
         {"spots", O::kHemi, kField, "4 (0 with directions=tree)", "an integer in 0..16",
          "narrow lobes per hemisphere aimed at small bright spots that a stratum is too coarse "
          "for (a lamp's opening, a light's highlight on a near-specular surface; 0: off)"},

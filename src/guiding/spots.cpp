@@ -63,7 +63,17 @@ void SpotLobes::reset(size_t regions, const SpotSettings& settings) {
     active_.shrink_to_fit();
     activeCount_.assign(regions, 0);
     share_.assign(regions, 0.f);
+    worth_.assign(regions, 0.f);
+    silenced_ = false;
     slots_.clear();
+}
+
+void SpotLobes::setSilenced(bool silenced) {
+    silenced_ = silenced;
+    if (!silenced) return;
+    std::fill(activeCount_.begin(), activeCount_.end(), uint8_t(0));
+    std::fill(share_.begin(), share_.end(), 0.f);
+    std::fill(worth_.begin(), worth_.end(), 0.f);
 }
 
 void SpotLobes::allocate(size_t region) {
@@ -213,10 +223,16 @@ void SpotLobes::refit(size_t region, double regionTotal) {
         active += lobe.sumLight;
     }
     const double share = regionTotal > 0.0 ? active / regionTotal : settings_.maxShare;
-    if (m == 0 || share < kMinActiveShare) {
+    worth_[region] = 0.f;
+    if (m == 0 || share < kMinActiveShare || silenced_) {
         activeCount_[region] = 0;
         share_[region] = 0.f;
         return;
+    }
+    if (regionTotal > 0.0) {
+        double worth = 0.0;
+        for (int i = 0; i < m; ++i) worth += double(act[i].norm) * double(act[i].kappa);
+        worth_[region] = float(worth / (regionTotal * double(std::max(settings_.minKappa, 1.f))));
     }
     activeCount_[region] = uint8_t(m);
     double cum = 0.0;

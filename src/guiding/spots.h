@@ -41,6 +41,19 @@ public:
     size_t regions() const { return share_.size(); }
     const SpotSettings& settings() const { return settings_; }
 
+    // What a region's active lobes are worth: the sum over them of (the lobe's light / the
+    // region's) x kappa / minKappa, i.e. their light weighted by how many times narrower
+    // than a stratum each is (about the factor by which the strata alone would raise the
+    // second moment of that light); 0 without active lobes. Set when the lobes are refitted.
+    float worth(int region) const {
+        return region >= 0 && size_t(region) < worth_.size() ? worth_[size_t(region)] : 0.f;
+    }
+    // setSilenced(true) stops every region's lobes for good (the field's verdict,
+    // HemiParams::spotJudge): no lobe samples or has a density from now on, refits included;
+    // what they learned stays (and is saved) as it is. setSilenced(false) lets the next
+    // refit decide again (a field loaded from a file).
+    void setSilenced(bool silenced);
+    bool silenced() const { return silenced_; }
     // The probability of sampling the lobes at a region (0: none there). Frozen per pass.
     float share(int region) const {
         return region >= 0 && size_t(region) < share_.size() ? share_[size_t(region)] : 0.f;
@@ -157,6 +170,8 @@ private:
     std::vector<Active> active_;        // blocks x perRegion, the first activeCount_ used
     std::vector<uint8_t> activeCount_;
     std::vector<float> share_;          // frozen per pass
+    std::vector<float> worth_;          // per region (worth())
+    bool silenced_ = false;
     std::vector<std::vector<Candidate>> slots_;
 };
 

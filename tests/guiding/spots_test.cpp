@@ -117,7 +117,7 @@ TEST(HemiSpots, UntrainedFieldIsTheStrata) {
 }
 
 TEST(HemiSpots, TrainedLobesAimAtTheSpotAndMatchTheirPdf) {
-    auto f = makeHemi({{"points", "16"}, {"spots", "2"}, {"warmup", "0"}});
+    auto f = makeHemi({{"points", "16"}, {"spots", "2"}, {"warmup", "0"}, {"spot-judge", "0"}});
     ASSERT_TRUE(f);
     const int region = 4;
     trainBright(*f, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);  // Q ~ 0.05 .. 100
@@ -138,7 +138,7 @@ TEST(HemiSpots, TrainedLobesAimAtTheSpotAndMatchTheirPdf) {
         EXPECT_NEAR(r.pdfIntegral, 1.0, 3e-3);
     }
     // Dim candidates (below spot-outlier x the stratum's Q) shape nothing.
-    auto g = makeHemi({{"points", "16"}, {"spots", "2"}, {"warmup", "0"}});
+    auto g = makeHemi({{"points", "16"}, {"spots", "2"}, {"warmup", "0"}, {"spot-judge", "0"}});
     trainBright(*g, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);
     trainSpot(*g, region, xc, spot, 0.02f, 1e-3f, 2, 5);
     EXPECT_EQ(g->spots()->activeLobes(), 0u);
@@ -146,7 +146,7 @@ TEST(HemiSpots, TrainedLobesAimAtTheSpotAndMatchTheirPdf) {
 
 TEST(HemiSpots, LobeSamplesStayOutOfTheStrata) {
     auto f = makeHemi({{"points", "16"}, {"spots", "1"}, {"warmup", "0"},
-                       {"spot-share", "1"}});
+                       {"spot-share", "1"}, {"spot-judge", "0"}});
     ASSERT_TRUE(f);
     const int region = 4;
     trainBright(*f, region, glm::vec3(0.f, 0.f, 1.f), 1, 3);
@@ -196,7 +196,7 @@ int lobeMismatches(const HemiField& a, const HemiField& b) {
 
 TEST(HemiSpots, SavedStateRestoresTheLobesAndLearnsOnAlike) {
     const std::map<std::string, std::string> params = {
-        {"points", "16"}, {"spots", "2"}, {"warmup", "0"}};
+        {"points", "16"}, {"spots", "2"}, {"warmup", "0"}, {"spot-judge", "0"}};
     auto f = makeHemi(params);
     ASSERT_TRUE(f);
     const int region = 4;
@@ -273,12 +273,65 @@ TEST(HemiSpots, CorruptLobeBytesAreRefused) {
 // same narrow cluster against a small region total does.
 // prune never leaves a region with spot lobes to the BSDF: its strata may be even (a small
 // lamp is far below a stratum's resolution) while the lobes are what its guide is for.
+// spot-judge: once the regions are confident (0.8), lobes worth less than the verdict's
+// threshold (visit-weighted over the regions) stop for good; worth more, they stay. A field
+// loaded from the silenced one's state reaches the same verdict.
+TEST(HemiSpots, SpotJudgeStopsLobesWorthLittle) {
+    for (const char* threshold : {"1e-9", "1e9"}) {
+        SCOPED_TRACE(threshold);
+        const std::map<std::string, std::string> params = {
+            {"points", "16"}, {"spots", "2"}, {"warmup", "0"}, {"judge", "0"},
+            {"spot-judge", threshold}};
+        auto f = makeHemi(params);
+        ASSERT_TRUE(f);
+        const int region = 4;
+        const glm::vec3 xc = f->regionPosition(region);
+        const glm::vec3 spot = xc + glm::vec3(0.6f, -0.3f, 0.5f);
+        // One pass (warmup 0: the verdict follows it): the strata's light and the spot's.
+        std::mt19937_64 rng(3);
+        std::normal_distribution<float> gauss(0.f, 1.f);
+        f->beginPass(1);
+        for (int i = 0; i < 20000; ++i) {
+            const glm::vec3 w = test::gaussianDirection(rng);
+            f->record(0, region, w, w.z > 0.9f ? 100.f : 0.05f);
+        }
+        for (int i = 0; i < 200; ++i) {
+            const glm::vec3 x = xc + 0.05f * glm::vec3(gauss(rng), gauss(rng), 0.f);
+            const glm::vec3 hit = spot + 0.02f * glm::vec3(gauss(rng), gauss(rng), gauss(rng));
+            f->recordSpot(0, region, x, glm::normalize(hit - x), hit, 1e4f);
+        }
+        f->endPass();
+        const bool stays = std::string(threshold) == "1e-9";
+        EXPECT_EQ(f->spots()->silenced(), !stays);
+        EXPECT_EQ(f->learnsSpots(), stays);
+        const glm::vec3 toSpot = glm::normalize(spot - xc);
+        if (stays) {
+            EXPECT_GT(f->spotWorth(), 0.0);
+            EXPECT_GT(f->pdfAt(region, xc, toSpot), 20.f * f->pdf(region, toSpot));
+            continue;
+        }
+        // Silenced: the strata alone, which a chi-square test of the sampler confirms.
+        EXPECT_EQ(f->spots()->activeLobes(), 0u);
+        EXPECT_EQ(f->pdfAt(region, xc, toSpot), f->pdf(region, toSpot));
+        chi2::SphereResult r = test::sphereTestAt(*f, region, xc, 23);
+        EXPECT_TRUE(r.passed) << r.message;
+        EXPECT_NEAR(r.pdfIntegral, 1.0, 3e-3);
+        EXPECT_NE(f->describe().find("lobes off"), std::string::npos) << f->describe();
+        std::string state, error;
+        ASSERT_TRUE(f->saveState(&state, &error)) << error;
+        auto g = makeHemi(params);
+        ASSERT_TRUE(g->loadState(state, &error)) << error;
+        EXPECT_TRUE(g->spots()->silenced());
+        EXPECT_EQ(g->pdfAt(region, xc, toSpot), f->pdfAt(region, xc, toSpot));
+    }
+}
+
 TEST(HemiSpots, RegionWithLobesIsNeverPruned) {
     for (bool spots : {false, true}) {
         SCOPED_TRACE(spots);
         auto f = makeHemi(
             {{"points", "16"}, {"spots", spots ? "2" : "0"}, {"prune", "0.5"}, {"warmup", "0"},
-             {"judge", "0"}});
+             {"judge", "0"}, {"spot-judge", "0"}});
         ASSERT_TRUE(f);
         const int region = 4;
         const glm::vec3 n = f->regionNormal(region);
@@ -294,6 +347,48 @@ TEST(HemiSpots, RegionWithLobesIsNeverPruned) {
         ASSERT_GT(f->spots()->share(region), 0.f);
         EXPECT_TRUE(f->guides(region));
     }
+}
+
+// A lobe's worth to its region: its light share times how many times narrower than a
+// stratum it is (kappa / minKappa); silenced lobes neither sample nor come back on a refit.
+TEST(SpotLobes, WorthIsTheLightShareTimesTheNarrowingAndSilenceStopsThem) {
+    SpotSettings ss;
+    ss.perRegion = 2;
+    ss.minKappa = 256.f;
+    SpotLobes lobes;
+    lobes.reset(2, ss);
+    auto pass = [&lobes] {
+        lobes.beginPass(1);
+        for (int i = 0; i < 8; ++i) {
+            const glm::vec3 w = glm::normalize(
+                glm::vec3(0.002f * float(i % 3 - 1), 0.002f * float(i / 3 - 1), 1.f));
+            lobes.record(0, 0, glm::vec3(0.f), w, w, 100.f, 1.f);
+        }
+        lobes.endPass([](size_t) { return 1000.0; });
+    };
+    pass();
+    const glm::vec3 up(0.f, 0.f, 1.f);
+    ASSERT_EQ(lobes.activeLobes(), 1u);
+    // One lobe: its density at its axis is kappa / (2 pi (1 - e^(-2 kappa))), so kappa.
+    const double kappa = 2.0 * 3.14159265358979 * double(lobes.pdf(0, glm::vec3(0.f), up));
+    ASSERT_GT(kappa, 256.0);
+    const double share = 800.0 / 1000.0;
+    // (kappa read back from the float density: to 0.5%)
+    EXPECT_NEAR(lobes.worth(0), share * kappa / 256.0, 5e-3 * share * kappa / 256.0);
+    EXPECT_EQ(lobes.worth(1), 0.f);  // no lobes there
+    EXPECT_EQ(lobes.worth(-1), 0.f);
+    lobes.setSilenced(true);
+    EXPECT_TRUE(lobes.silenced());
+    EXPECT_EQ(lobes.share(0), 0.f);
+    EXPECT_EQ(lobes.pdf(0, glm::vec3(0.f), up), 0.f);
+    EXPECT_EQ(lobes.worth(0), 0.f);
+    pass();  // learning on does not bring them back
+    EXPECT_EQ(lobes.share(0), 0.f);
+    EXPECT_EQ(lobes.activeLobes(), 0u);
+    lobes.setSilenced(false);
+    lobes.refitAll([](size_t) { return 1000.0; });
+    EXPECT_EQ(lobes.activeLobes(), 1u);
+    EXPECT_GT(lobes.share(0), 0.f);
 }
 
 TEST(SpotLobes, WideOrFaintLobesDoNotSample) {

@@ -577,6 +577,8 @@ const Extreme kExtremes[] = {
     {"prune_1e9", {{"prune", "1e9"}, {"warmup", "0"}}},
     {"prune_1e_9", {{"prune", "1e-9"}, {"warmup", "0"}}},
     {"judge_tiny", {{"judge", "1e-6"}, {"warmup", "0"}}},
+    {"spot_judge_huge", {{"spot-judge", "1e30"}, {"spots", "16"}, {"spot-outlier", "1"},
+                         {"warmup", "0"}}},
 };
 
 INSTANTIATE_TEST_SUITE_P(Hemi, GuideExtremes, ::testing::ValuesIn(kExtremes),
