@@ -524,13 +524,17 @@ void HemiField::endPass() {
     judgeScene();
 }
 
-double HemiField::directionGuidingRatio(double* confidence) const {
+HemiField::SceneMeasures HemiField::sceneMeasures() const {
     std::vector<double> q(static_cast<size_t>(strata_));
-    double visits = 0.0, conf = 0.0, cosine = 0.0, mixture = 0.0;
+    // visits: of the regions with learned light (the ratio's and the confidence's weights);
+    // all: of every visited region (the spot worth's).
+    double visits = 0.0, conf = 0.0, cosine = 0.0, mixture = 0.0, all = 0.0, worth = 0.0;
     const double n = double(strata_), eps = params_.epsilon;
     for (int r = 0; r < numRegions(); ++r) {
         const double v = table_.visitsTotal(size_t(r));
         if (!(v > 0.0)) continue;
+        all += v;
+        if (spots_) worth += v * double(spots_->worth(r));
         table_.estimate(size_t(r), q.data());
         double qc = 0.0, cs = 0.0;
         for (int j = 0; j < strata_; ++j) {
@@ -561,43 +565,31 @@ double HemiField::directionGuidingRatio(double* confidence) const {
         cosine += v * sc;
         mixture += v * sm;
     }
-    *confidence = visits > 0.0 ? conf / visits : 0.0;
-    return cosine > 0.0 && std::isfinite(mixture / cosine) ? mixture / cosine : 1.0;
+    SceneMeasures m;
+    if (visits > 0.0) m.confidence = conf / visits;
+    if (all > 0.0) m.spotWorth = worth / all;
+    if (cosine > 0.0 && std::isfinite(mixture / cosine)) m.ratio = mixture / cosine;
+    return m;
 }
 
 namespace {
 constexpr double kSpotJudgeConfidence = 0.8;
 }  // namespace
 
-double HemiField::spotWorth() const {
-    if (!spots_) return 0.0;
-    double visits = 0.0, worth = 0.0;
-    for (int r = 0; r < numRegions(); ++r) {
-        const double v = table_.visitsTotal(size_t(r));
-        if (!(v > 0.0)) continue;
-        visits += v;
-        worth += v * double(spots_->worth(r));
-    }
-    return visits > 0.0 ? worth / visits : 0.0;
-}
-
 void HemiField::judgeScene() {
     if (directionsOff_ || trees_) return;
     const bool directions = params_.judge > 0.0;
     const bool spots = params_.spotJudge > 0.0 && spots_ && !spots_->silenced();
     if (!directions && !spots) return;
-    double confidence = 0.0;
-    const double ratio = directionGuidingRatio(&confidence);
-    if (confidence < 0.5) return;
-    if (directions && ratio > params_.judge) directionsOff_ = true;
+    const SceneMeasures m = sceneMeasures();
+    if (m.confidence < 0.5) return;
+    if (directions && m.ratio > params_.judge) directionsOff_ = true;
     // Lobes sharpen and gain light share as they learn: their worth is judged later, at
     // confidence 0.8 (session 45: at 0.5 glossy-lamps' lobes were worth 0.14, at 0.8 8.5).
-    if (spots && !directionsOff_ && confidence >= kSpotJudgeConfidence) {
-        const double worth = spotWorth();
-        if (worth < params_.spotJudge) {
-            spotWorthAtVerdict_ = worth;
-            spots_->setSilenced(true);
-        }
+    if (spots && !directionsOff_ && m.confidence >= kSpotJudgeConfidence &&
+        m.spotWorth < params_.spotJudge) {
+        spotWorthAtVerdict_ = m.spotWorth;
+        spots_->setSilenced(true);
     }
 }
 
@@ -686,6 +678,7 @@ std::string HemiField::describe() const {
                       double(trees_->bytes()) / (1024.0 * 1024.0));
         line += buf;
     }
+    const SceneMeasures measures = trees_ ? SceneMeasures() : sceneMeasures();
     if (spots_) {
         std::snprintf(buf, sizeof(buf), "; spots=%d (share %g, outlier %g): %zu lobes in %zu hemispheres",
                       params_.spots, params_.spotShare, params_.spotOutlier,
@@ -694,7 +687,7 @@ std::string HemiField::describe() const {
         if (params_.spotJudge > 0.0 && !trees_) {
             const bool off = spots_->silenced();
             std::snprintf(buf, sizeof(buf), ", spot judge %g: worth %.3g, %s", params_.spotJudge,
-                          off ? spotWorthAtVerdict_ : spotWorth(), off ? "lobes off" : "lobes on");
+                          off ? spotWorthAtVerdict_ : measures.spotWorth, off ? "lobes off" : "lobes on");
             line += buf;
         }
     }
@@ -715,10 +708,9 @@ std::string HemiField::describe() const {
         line += buf;
     }
     if (params_.judge > 0.0 && !trees_) {
-        double confidence = 0.0;
-        const double ratio = directionGuidingRatio(&confidence);
         std::snprintf(buf, sizeof(buf), "; judge %g: predicted second moment %.3f of cosine "
-                      "sampling's at confidence %.2f, %s", params_.judge, ratio, confidence,
+                      "sampling's at confidence %.2f, %s", params_.judge, measures.ratio,
+                      measures.confidence,
                       directionsOff_ ? (active() ? "directions off" : "field off")
                                      : "guiding");
         line += buf;

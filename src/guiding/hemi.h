@@ -188,15 +188,21 @@ public:
     // Whether the judge stopped direction guiding (every region samples the BSDF alone and
     // learns no directions).
     bool directionsOff() const { return directionsOff_; }
-    // The judge's prediction from the tables as they are: the visit-weighted second moment
-    // of the strata's learned light under the guide's mixture (mix 0.5 x confidence where a
-    // region guides; a region with spot lobes of share s at most 1 - s of its cosine
-    // sampling's) over cosine sampling's; *confidence: the regions' visit-weighted
-    // confidence. 1 (and 0) without visits.
-    double directionGuidingRatio(double* confidence) const;
-    // The spot verdict's measure (HemiParams::spotJudge): the visit-weighted mean of the
-    // regions' SpotLobes::worth (0 without spots or visits).
-    double spotWorth() const;
+    // What the scene verdicts (judgeScene) read from the tables as they are, in one pass over
+    // the regions with visits.
+    struct SceneMeasures {
+        // The judge's prediction: the visit-weighted second moment of the strata's learned
+        // light under the guide's mixture (mix 0.5 x confidence where a region guides; a
+        // region with spot lobes of share s at most 1 - s of its cosine sampling's) over
+        // cosine sampling's, over the regions with learned light; 1 without them.
+        double ratio = 1.0;
+        // The visit-weighted confidence of the regions with learned light (0 without them).
+        double confidence = 0.0;
+        // The spot verdict's measure (HemiParams::spotJudge): the visit-weighted mean of
+        // every visited region's SpotLobes::worth (0 without spots or visits).
+        double spotWorth = 0.0;
+    };
+    SceneMeasures sceneMeasures() const;
     bool learns(int region) const override {
         return !directionsOff_ && validRegion(region) && frames_[size_t(region)].learns;
     }
@@ -354,7 +360,8 @@ private:
     std::function<bool(uint32_t, glm::vec3*, glm::vec3*)> patchCentre_;
     // The judge's verdict (HemiParams::judge): direction guiding stopped for good.
     bool directionsOff_ = false;
-    // The spot verdict's worth (spotWorth() when it stopped the lobes), for describe().
+    // The spot verdict's worth (sceneMeasures().spotWorth when it stopped the lobes), for
+    // describe().
     double spotWorthAtVerdict_ = 0.0;
     // Judges directions (judge) and spot lobes (spotJudge) once the regions' confidence
     // suffices (endPass, endPassShared, loads).

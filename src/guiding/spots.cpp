@@ -199,7 +199,7 @@ void SpotLobes::refit(size_t region, double regionTotal) {
     Lobe* l = lobesOf(region);
     Active* act = activeOf(region);
     const int n = lobeCount_[region];
-    double active = 0.0;
+    double active = 0.0, lightKappa = 0.0;  // the active lobes' light, and light x kappa
     int m = 0;
     for (int i = 0; i < n; ++i) {
         Lobe& lobe = l[i];
@@ -221,6 +221,7 @@ void SpotLobes::refit(size_t region, double regionTotal) {
         a.kappa = lobe.kappa;
         a.norm = float(lobe.sumLight);  // normalised below
         active += lobe.sumLight;
+        lightKappa += lobe.sumLight * double(lobe.kappa);
     }
     const double share = regionTotal > 0.0 ? active / regionTotal : settings_.maxShare;
     worth_[region] = 0.f;
@@ -229,11 +230,9 @@ void SpotLobes::refit(size_t region, double regionTotal) {
         share_[region] = 0.f;
         return;
     }
-    if (regionTotal > 0.0) {
-        double worth = 0.0;
-        for (int i = 0; i < m; ++i) worth += double(act[i].norm) * double(act[i].kappa);
-        worth_[region] = float(worth / (regionTotal * double(std::max(settings_.minKappa, 1.f))));
-    }
+    if (regionTotal > 0.0)
+        worth_[region] =
+            float(lightKappa / (regionTotal * double(std::max(settings_.minKappa, 1.f))));
     activeCount_[region] = uint8_t(m);
     double cum = 0.0;
     for (int i = 0; i < m; ++i) {

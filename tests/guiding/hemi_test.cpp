@@ -557,13 +557,13 @@ TEST(HemiField, JudgeStopsDirectionGuidingWhereItCannotGain) {
         SCOPED_TRACE(judge);
         auto f = makeHemi(planeScene(), {{"smooth", "0"}, {"prune", "0"}, {"judge", judge}});
         ASSERT_TRUE(f);
-        double confidence = -1.0;
-        EXPECT_EQ(f->directionGuidingRatio(&confidence), 1.0);  // no visits yet
-        EXPECT_EQ(confidence, 0.0);
+        EXPECT_EQ(f->sceneMeasures().ratio, 1.0);  // no visits yet
+        EXPECT_EQ(f->sceneMeasures().confidence, 0.0);
         // 16 records per stratum: confidence 16 / (16 + warmup 8) = 2/3 after one pass.
         trainEven(*f, r, 1);
-        const double ratio = f->directionGuidingRatio(&confidence);
-        EXPECT_NEAR(confidence, 2.0 / 3.0, 1e-6);
+        const HemiField::SceneMeasures m = f->sceneMeasures();
+        const double ratio = m.ratio;
+        EXPECT_NEAR(m.confidence, 2.0 / 3.0, 1e-6);
         // Even light: the guide's CDF is cosine sampling mixed with epsilon's uniform share,
         // slightly worse than cosine sampling alone.
         EXPECT_GT(ratio, 1.0);
@@ -594,9 +594,8 @@ TEST(HemiField, JudgeStopsDirectionGuidingWhereItCannotGain) {
     // A concentrated light: predicted far below cosine sampling, the guide stays.
     auto f = makeHemi(planeScene(), {{"judge", "0.9"}});
     trainBright(*f, 4, glm::normalize(glm::vec3(0.3f, -0.2f, 1.f)), 2, 5);
-    double confidence = 0.0;
-    EXPECT_LT(f->directionGuidingRatio(&confidence), 0.5);
-    EXPECT_GE(confidence, 0.5);
+    EXPECT_LT(f->sceneMeasures().ratio, 0.5);
+    EXPECT_GE(f->sceneMeasures().confidence, 0.5);
     EXPECT_FALSE(f->directionsOff());
     EXPECT_TRUE(f->active());
     EXPECT_TRUE(f->guides(4));

@@ -306,7 +306,7 @@ TEST(HemiSpots, SpotJudgeStopsLobesWorthLittle) {
         EXPECT_EQ(f->learnsSpots(), stays);
         const glm::vec3 toSpot = glm::normalize(spot - xc);
         if (stays) {
-            EXPECT_GT(f->spotWorth(), 0.0);
+            EXPECT_GT(f->sceneMeasures().spotWorth, 0.0);
             EXPECT_GT(f->pdfAt(region, xc, toSpot), 20.f * f->pdf(region, toSpot));
             continue;
         }
